@@ -1,0 +1,6 @@
+find_path(GMSH_INCLUDE_DIR gmsh.h REQUIRED)
+find_library(GMSH_LIBRARY gmsh REQUIRED)
+add_library(shatter_dep_gmsh INTERFACE)
+target_include_directories(shatter_dep_gmsh SYSTEM INTERFACE ${GMSH_INCLUDE_DIR})
+target_link_libraries(shatter_dep_gmsh INTERFACE ${GMSH_LIBRARY})
+add_library(Gmsh::gmsh ALIAS shatter_dep_gmsh)

@@ -1,0 +1,6 @@
+find_path(METIS_INCLUDE_DIR metis.h REQUIRED)
+find_library(METIS_LIBRARY metis REQUIRED)
+add_library(shatter_dep_metis INTERFACE)
+target_include_directories(shatter_dep_metis SYSTEM INTERFACE ${METIS_INCLUDE_DIR})
+target_link_libraries(shatter_dep_metis INTERFACE ${METIS_LIBRARY})
+add_library(METIS::metis ALIAS shatter_dep_metis)

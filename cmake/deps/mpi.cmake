@@ -1,0 +1,1 @@
+find_package(MPI REQUIRED COMPONENTS C CXX)

@@ -1,0 +1,134 @@
+#pragma once
+// Quadratic 10-node tetrahedron, 4-point Gauss rule (degree 2; Zienkiewicz &
+// Taylor, "The Finite Element Method", vol. 1, table 9.3: a = 0.5854101966249685,
+// b = 0.1381966011250105, weights 1/24 on the unit tetrahedron).
+// Node order (Gmsh): corners 0..3, then mid-edge nodes on edges
+//   4:(0,1) 5:(1,2) 6:(0,2) 7:(0,3) 8:(2,3) 9:(1,3).
+// Shape functions in barycentrics L0 = 1 - xi - eta - zeta, L1 = xi, L2 = eta, L3 = zeta:
+//   corner i: L_i (2 L_i - 1),   edge (i,j): 4 L_i L_j.
+#include <array>
+#include <cmath>
+
+#include "kernels/neo_hookean.hpp"
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+inline constexpr std::array<std::array<int, 2>, 6> kTet10Edges = {
+    {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}}};
+
+using Tet10Nodes = Eigen::Matrix<double, 3, 10>;      ///< columns = node coordinates
+using Tet10Gradients = Eigen::Matrix<double, 10, 3>;  ///< rows = dN_a/dX
+
+/// Shape function values at reference point (xi, eta, zeta).
+inline Eigen::Matrix<double, 10, 1> tet10_shape(const Vec3& p) {
+  const double L[4] = {1.0 - p[0] - p[1] - p[2], p[0], p[1], p[2]};
+  Eigen::Matrix<double, 10, 1> N;
+  for (int i = 0; i < 4; ++i) N[i] = L[i] * (2.0 * L[i] - 1.0);
+  for (int e = 0; e < 6; ++e) N[4 + e] = 4.0 * L[kTet10Edges[e][0]] * L[kTet10Edges[e][1]];
+  return N;
+}
+
+/// Shape function derivatives dN_a/dxi_k at reference point (xi, eta, zeta).
+inline Tet10Gradients tet10_shape_derivatives(const Vec3& p) {
+  const double L[4] = {1.0 - p[0] - p[1] - p[2], p[0], p[1], p[2]};
+  // dL_i/dxi_k
+  static const double dL[4][3] = {{-1, -1, -1}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  Tet10Gradients d;
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) d(i, k) = (4.0 * L[i] - 1.0) * dL[i][k];
+  for (int e = 0; e < 6; ++e) {
+    const int i = kTet10Edges[e][0], j = kTet10Edges[e][1];
+    for (int k = 0; k < 3; ++k) d(4 + e, k) = 4.0 * (dL[i][k] * L[j] + L[i] * dL[j][k]);
+  }
+  return d;
+}
+
+/// The 4-point rule: reference points and weights (sum of weights = 1/6).
+inline const std::array<Vec3, 4>& tet10_quadrature_points() {
+  static const double a = 0.5854101966249685, b = 0.1381966011250105;
+  static const std::array<Vec3, 4> pts = {Vec3(b, b, b), Vec3(a, b, b), Vec3(b, a, b), Vec3(b, b, a)};
+  return pts;
+}
+inline constexpr double kTet10QuadratureWeight = 1.0 / 24.0;
+
+/// Reference constants of one TET10: per quadrature point, dN/dX and
+/// weight x det(dX/dxi) (reference volume measure, m^3).
+struct Tet10Reference {
+  std::array<Tet10Gradients, 4> dNdX;
+  std::array<double, 4> wdetJ;
+  double volume;   ///< sum of wdetJ, m^3
+  double min_jacobian;  ///< smallest det(dX/dxi) over the points (inverted if <= 0)
+};
+
+inline Tet10Reference tet10_reference(const Tet10Nodes& X) {
+  Tet10Reference r;
+  r.volume = 0.0;
+  r.min_jacobian = HUGE_VAL;
+  const auto& pts = tet10_quadrature_points();
+  for (int q = 0; q < 4; ++q) {
+    const Tet10Gradients dNdxi = tet10_shape_derivatives(pts[q]);
+    const Mat3 J = X * dNdxi;  // dX/dxi
+    const double detJ = J.determinant();
+    r.dNdX[q] = dNdxi * J.inverse();
+    r.wdetJ[q] = kTet10QuadratureWeight * detJ;
+    r.volume += r.wdetJ[q];
+    r.min_jacobian = std::min(r.min_jacobian, detJ);
+  }
+  return r;
+}
+
+/// Internal nodal forces dE/dx (columns = nodes), strain energy (J) and the
+/// smallest det F over the quadrature points.
+struct Tet10Force {
+  Eigen::Matrix<double, 3, 10> f;
+  double energy;
+  double J;
+};
+
+template <class Material>
+inline Tet10Force tet10_internal_force(const Tet10Nodes& x, const Tet10Reference& ref, const Material& mat) {
+  Tet10Force out;
+  out.f.setZero();
+  out.energy = 0.0;
+  out.J = HUGE_VAL;
+  for (int q = 0; q < 4; ++q) {
+    const Mat3 F = x * ref.dNdX[q];
+    Mat3 P;
+    double W;
+    mat.stress_energy(F, P, W);
+    out.f.noalias() += ref.wdetJ[q] * P * ref.dNdX[q].transpose();
+    out.energy += ref.wdetJ[q] * W;
+    out.J = std::min(out.J, F.determinant());
+  }
+  return out;
+}
+
+/// HRZ lumped mass fractions of a TET10 (Hinton, Rock & Zienkiewicz, Earthquake
+/// Eng. Struct. Dyn. 4 (1976) 245): m_a = M_aa / sum_b M_bb x (rho V), with M the
+/// consistent mass matrix. Row-sum lumping gives negative corner masses for
+/// TET10 (-1/20 of the element mass), unusable in explicit dynamics; HRZ keeps
+/// every mass positive and the total exact. For straight-sided elements the
+/// fractions are 1/36 (corners) and 4/27 (edges); curved elements use the
+/// same definition evaluated with a collapsed Gauss rule exact to degree 9.
+inline Eigen::Matrix<double, 10, 1> tet10_hrz_mass_fractions(const Tet10Nodes& X) {
+  // 5-point Gauss-Legendre on [0,1] mapped through the Duffy collapse
+  // (u,v,w) -> xi = u, eta = (1-u) v, zeta = (1-u)(1-v) w, Jacobian (1-u)^2 (1-v).
+  static const double g[5] = {0.0469100770306680, 0.2307653449471585, 0.5, 0.7692346550528415,
+                              0.9530899229693320};
+  static const double gw[5] = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444,
+                               0.2393143352496832, 0.1184634425280945};
+  Eigen::Matrix<double, 10, 1> diag = Eigen::Matrix<double, 10, 1>::Zero();
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k) {
+        const double u = g[i], v = g[j], w = g[k];
+        const Vec3 p(u, (1 - u) * v, (1 - u) * (1 - v) * w);
+        const double wt = gw[i] * gw[j] * gw[k] * (1 - u) * (1 - u) * (1 - v);
+        const double detJ = (X * tet10_shape_derivatives(p)).determinant();
+        diag += (wt * detJ) * tet10_shape(p).cwiseAbs2();
+      }
+  return diag / diag.sum();
+}
+
+}  // namespace shatter

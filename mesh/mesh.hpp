@@ -1,0 +1,53 @@
+#pragma once
+// Volume mesh storage: struct of arrays, indexed by local ids, with global
+// ids beside them (DESIGN.md "Data layout").
+#include <string>
+#include <vector>
+
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+/// A tetrahedral mesh of one or more bodies, all of one order.
+///
+/// Layouts (n = nodes, e = elements, k = nodes_per_element()):
+///   reference[n]      reference coordinates X, m
+///   node_gid[n]       global node id
+///   node_body[n]      body index of the node
+///   conn[e*k + a]     local node id of element node a (Gmsh node order)
+///   elem_gid[e], elem_body[e], elem_material[e]
+///   node_elem_offsets[n+1], node_elem[...]: CSR node -> elements (ascending)
+struct Mesh {
+  int order = 1;  ///< 1 = TET4, 2 = TET10
+  std::vector<Vec3> reference;
+  std::vector<GlobalId> node_gid;
+  std::vector<int> node_body;
+  std::vector<Index> conn;
+  std::vector<GlobalId> elem_gid;
+  std::vector<int> elem_body;
+  std::vector<int> elem_material;
+  std::vector<Index> node_elem_offsets;
+  std::vector<Index> node_elem;
+
+  int nodes_per_element() const { return order == 1 ? 4 : 10; }
+  Index num_nodes() const { return static_cast<Index>(reference.size()); }
+  Index num_elements() const { return static_cast<Index>(elem_gid.size()); }
+  const Index* element(Index e) const { return conn.data() + static_cast<size_t>(e) * nodes_per_element(); }
+
+  /// Rebuild the node -> element CSR from conn.
+  void build_node_elements();
+};
+
+/// Append mesh `b` to `a` (same order); node and element ids of `b` are
+/// shifted, and its global ids (Gmsh tags) offset past the largest of `a`.
+/// Validate each body's mesh before appending, so errors name the file's tags.
+void append_mesh(Mesh& a, const Mesh& b);
+
+/// Check a mesh for inverted or zero-volume elements and unused nodes; throws
+/// InputError naming `where` (file/key) and the first offending element or node.
+void validate_mesh(const Mesh& mesh, const std::string& where);
+
+/// Signed reference volume of element e (for TET10: integral of det(dX/dxi)).
+double element_reference_volume(const Mesh& mesh, Index e);
+
+}  // namespace shatter
