@@ -1,6 +1,7 @@
 #pragma once
 // Volume mesh storage: struct of arrays, indexed by local ids, with global
 // ids beside them (DESIGN.md "Data layout").
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ namespace shatter {
 ///   node_elem_offsets[n+1], node_elem[...]: CSR node -> elements (ascending)
 struct Mesh {
   int order = 1;  ///< 1 = TET4, 2 = TET10
+  /// Bumped by every change of topology (node splitting); outputs rewrite
+  /// their mesh when it changes.
+  std::uint64_t revision = 0;
   std::vector<Vec3> reference;
   std::vector<GlobalId> node_gid;
   std::vector<int> node_body;
