@@ -1,0 +1,141 @@
+#include "contact/candidates.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+namespace {
+
+template <size_t K>
+Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+  Box b{x_old[nodes[0]], x_old[nodes[0]]};
+  for (const Index n : nodes) {
+    b.lo = b.lo.cwiseMin(x_old[n]).cwiseMin(x_new[n]);
+    b.hi = b.hi.cwiseMax(x_old[n]).cwiseMax(x_new[n]);
+  }
+  const double grow = kBoxInflation * (b.hi - b.lo).maxCoeff();
+  b.lo.array() -= grow;
+  b.hi.array() += grow;
+  return b;
+}
+
+template <size_t K, class Nodes>
+void fill_boxes(std::vector<Box>& out, const Nodes& nodes, std::span<const Vec3> x_old,
+                std::span<const Vec3> x_new) {
+  out.resize(nodes.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size()), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      if constexpr (K == 1)
+        out[k] = swept_box(std::array<Index, 1>{nodes[k]}, x_old, x_new);
+      else
+        out[k] = swept_box(nodes[k], x_old, x_new);
+    }
+  });
+}
+
+/// Pairs collected in per-thread buffers, concatenated in a fixed order of
+/// the buffers' contents after canonicalize (which makes the order irrelevant).
+using PairBuffers = tbb::enumerable_thread_specific<ContactPairs>;
+
+ContactPairs concatenate(PairBuffers& buffers) {
+  size_t total = 0;
+  for (const auto& b : buffers) total += b.size();
+  ContactPairs all;
+  all.reserve(total);
+  for (const auto& b : buffers) all.insert(all.end(), b.begin(), b.end());
+  return all;
+}
+
+}  // namespace
+
+SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+  SHATTER_REQUIRE(x_old.size() == x_new.size(),
+                  "swept_boxes: x_old has " << x_old.size() << " nodes, x_new " << x_new.size());
+  SHATTER_REQUIRE(surface.vertices.empty() || static_cast<size_t>(surface.vertices.back()) < x_old.size(),
+                  "swept_boxes: surface node " << surface.vertices.back() << " beyond the " << x_old.size()
+                                               << " positions");
+  SweptBoxes boxes;
+  fill_boxes<3>(boxes.triangles, surface.triangles, x_old, x_new);
+  fill_boxes<2>(boxes.edges, surface.edges, x_old, x_new);
+  fill_boxes<1>(boxes.vertices, surface.vertices, x_old, x_new);
+  return boxes;
+}
+
+std::optional<ContactPair> vertex_face_pair(const ContactSurface& surface, Index v, Index t) {
+  const Index n = surface.vertices[v];
+  const auto& tri = surface.triangles[t];
+  if (n == tri[0] || n == tri[1] || n == tri[2]) return std::nullopt;
+  return ContactPair{ContactPair::VertexFace, {n, tri[0], tri[1], tri[2]}};
+}
+
+std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e, Index f) {
+  SHATTER_ASSERT(e < f);
+  const auto& a = surface.edges[e];
+  const auto& b = surface.edges[f];
+  if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return std::nullopt;
+  return ContactPair{ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}};
+}
+
+void canonicalize(ContactPairs& pairs) {
+  tbb::parallel_sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
+ContactPairs find_candidates(const ContactSurface& surface, std::span<const Vec3> x_old,
+                             std::span<const Vec3> x_new) {
+  return find_candidates(surface, swept_boxes(surface, x_old, x_new));
+}
+
+ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& boxes) {
+  SparseBucket triangles, edges;
+  tbb::parallel_invoke([&] { triangles = build_sparse_bucket(boxes.triangles); },
+                       [&] { edges = build_sparse_bucket(boxes.edges); });
+  PairBuffers buffers;
+  const size_t nv = boxes.vertices.size(), ne = boxes.edges.size();
+  // One range over vertex queries followed by edge queries, so both kinds
+  // share the load balancing.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + ne, 256), [&](const tbb::blocked_range<size_t>& r) {
+    ContactPairs& out = buffers.local();
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      if (k < nv) {
+        const auto v = static_cast<Index>(k);
+        query_sparse_bucket(triangles, boxes.triangles, boxes.vertices[k], [&](Index t) {
+          if (auto p = vertex_face_pair(surface, v, t)) out.push_back(*p);
+        });
+      } else {
+        const auto e = static_cast<Index>(k - nv);
+        query_sparse_bucket(edges, boxes.edges, boxes.edges[e], [&](Index f) {
+          if (e < f)
+            if (auto p = edge_edge_pair(surface, e, f)) out.push_back(*p);
+        });
+      }
+    }
+  });
+  ContactPairs pairs = concatenate(buffers);
+  canonicalize(pairs);
+  return pairs;
+}
+
+ContactPairs find_candidates_brute_force(const ContactSurface& surface, const SweptBoxes& boxes) {
+  ContactPairs pairs;
+  const auto nv = static_cast<Index>(boxes.vertices.size()), nt = static_cast<Index>(boxes.triangles.size());
+  const auto ne = static_cast<Index>(boxes.edges.size());
+  for (Index v = 0; v < nv; ++v)
+    for (Index t = 0; t < nt; ++t)
+      if (boxes_overlap(boxes.vertices[v], boxes.triangles[t]))
+        if (auto p = vertex_face_pair(surface, v, t)) pairs.push_back(*p);
+  for (Index e = 0; e < ne; ++e)
+    for (Index f = e + 1; f < ne; ++f)
+      if (boxes_overlap(boxes.edges[e], boxes.edges[f]))
+        if (auto p = edge_edge_pair(surface, e, f)) pairs.push_back(*p);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+}  // namespace shatter

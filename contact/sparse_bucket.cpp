@@ -1,0 +1,169 @@
+#include "contact/sparse_bucket.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_scan.h>
+#include <tbb/parallel_sort.h>
+
+#include <tuple>
+
+namespace shatter {
+namespace {
+
+double largest_side(const Box& b) { return (b.hi - b.lo).maxCoeff(); }
+
+Box bounding_box(std::span<const Box> boxes) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const Box empty{Vec3::Constant(inf), Vec3::Constant(-inf)};
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, boxes.size()), empty,
+      [&](const tbb::blocked_range<size_t>& r, Box acc) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+          acc.lo = acc.lo.cwiseMin(boxes[k].lo);
+          acc.hi = acc.hi.cwiseMax(boxes[k].hi);
+        }
+        return acc;
+      },
+      [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
+}
+
+/// h_0 = 2 x median largest side, the median taken over an evenly strided
+/// sample of at most 4096 boxes (deterministic). Degenerate sets (all points)
+/// fall back to the bounding box side over cbrt(n).
+double base_cell_size(std::span<const Box> boxes, const Box& all) {
+  const size_t stride = std::max<size_t>(1, boxes.size() / 4096);
+  std::vector<double> sample;
+  for (size_t k = 0; k < boxes.size(); k += stride) sample.push_back(largest_side(boxes[k]));
+  auto mid = sample.begin() + sample.size() / 2;
+  std::nth_element(sample.begin(), mid, sample.end());
+  const double span = largest_side(all);
+  double h = 2.0 * *mid;
+  if (!(h > 0)) h = span / std::max(1.0, std::cbrt(static_cast<double>(boxes.size())));
+  if (!(h > 0)) h = 1.0;
+  // keep cell indices inside 31 bits
+  return std::max(h, span * 0x1p-30);
+}
+
+struct Entry {
+  int level;
+  std::uint64_t key;
+  double lo;
+  Index box;
+};
+
+}  // namespace
+
+SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
+  SparseBucket b;
+  const size_t n = boxes.size();
+  if (n == 0) return b;
+  const Box all = bounding_box(boxes);
+  const Vec3 spread = all.hi - all.lo;
+  int w = 0;
+  for (int k = 1; k < 3; ++k)
+    if (spread[k] > spread[w]) w = k;
+  b.axis = {(w + 1) % 3, (w + 2) % 3, w};
+  b.origin = {all.lo[b.axis[0]], all.lo[b.axis[1]]};
+  const double h0 = base_cell_size(boxes, all);
+
+  // Level of each box: the smallest l with largest side <= h0 4^l.
+  std::vector<int> level(n);
+  const int max_level = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, n), 0,
+      [&](const tbb::blocked_range<size_t>& r, int acc) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+          const double s = largest_side(boxes[k]);
+          int l = 0;
+          for (double h = h0; s > h; h *= 4.0) ++l;
+          level[k] = l;
+          acc = std::max(acc, l);
+        }
+        return acc;
+      },
+      [](int a, int c) { return std::max(a, c); });
+  for (int l = 0; l <= max_level; ++l) b.cell_size.push_back(std::ldexp(h0, 2 * l));
+
+  const int u = b.axis[0], v = b.axis[1];
+  auto cell_range = [&](size_t k, std::uint32_t& i0, std::uint32_t& i1, std::uint32_t& j0, std::uint32_t& j1) {
+    const int l = level[k];
+    i0 = b.cell(0, l, boxes[k].lo[u]);
+    i1 = b.cell(0, l, boxes[k].hi[u]);
+    j0 = b.cell(1, l, boxes[k].lo[v]);
+    j1 = b.cell(1, l, boxes[k].hi[v]);
+  };
+
+  // Entries: one per (box, cell it spans); offsets by a parallel prefix sum.
+  std::vector<size_t> first(n + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      std::uint32_t i0, i1, j0, j1;
+      cell_range(k, i0, i1, j0, j1);
+      first[k + 1] = size_t(i1 - i0 + 1) * size_t(j1 - j0 + 1);
+    }
+  });
+  tbb::parallel_scan(
+      tbb::blocked_range<size_t>(1, n + 1), size_t(0),
+      [&](const tbb::blocked_range<size_t>& r, size_t sum, bool is_final) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+          sum += first[k];
+          if (is_final) first[k] = sum;
+        }
+        return sum;
+      },
+      [](size_t a, size_t c) { return a + c; });
+  std::vector<Entry> entries(first[n]);
+  const int wa = b.axis[2];
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      std::uint32_t i0, i1, j0, j1;
+      cell_range(k, i0, i1, j0, j1);
+      size_t p = first[k];
+      for (std::uint64_t i = i0; i <= i1; ++i)
+        for (std::uint64_t j = j0; j <= j1; ++j)
+          entries[p++] = {level[k], (i << 32) | j, boxes[k].lo[wa], static_cast<Index>(k)};
+    }
+  });
+  // A total order, so the sorted array is the same for any thread count.
+  tbb::parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& c) {
+    return std::tie(a.level, a.key, a.lo, a.box) < std::tie(c.level, c.key, c.lo, c.box);
+  });
+
+  const size_t m = entries.size();
+  b.entry_lo.resize(m);
+  b.entry_box.resize(m);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      b.entry_lo[k] = entries[k].lo;
+      b.entry_box[k] = entries[k].box;
+    }
+  });
+  b.level_cells.assign(1, 0);
+  b.cell_entries.assign(1, 0);
+  for (size_t k = 0; k < m;) {
+    size_t e = k;
+    double extent = 0;
+    for (; e < m && entries[e].level == entries[k].level && entries[e].key == entries[k].key; ++e) {
+      const Box& x = boxes[entries[e].box];
+      extent = std::max(extent, x.hi[wa] - x.lo[wa]);
+    }
+    while (static_cast<int>(b.level_cells.size()) <= entries[k].level)
+      b.level_cells.push_back(static_cast<Index>(b.cell_key.size()));
+    b.cell_key.push_back(entries[k].key);
+    b.cell_max_extent.push_back(extent);
+    b.cell_entries.push_back(static_cast<Index>(e));
+    k = e;
+  }
+  while (static_cast<int>(b.level_cells.size()) <= max_level + 1)
+    b.level_cells.push_back(static_cast<Index>(b.cell_key.size()));
+  return b;
+}
+
+std::size_t memory_bytes(const SparseBucket& b) {
+  return sizeof(SparseBucket) + b.cell_size.capacity() * sizeof(double) +
+         b.level_cells.capacity() * sizeof(Index) + b.cell_key.capacity() * sizeof(std::uint64_t) +
+         b.cell_entries.capacity() * sizeof(Index) + b.cell_max_extent.capacity() * sizeof(double) +
+         b.entry_lo.capacity() * sizeof(double) + b.entry_box.capacity() * sizeof(Index);
+}
+
+}  // namespace shatter

@@ -1,0 +1,121 @@
+#pragma once
+// Sparse-bucket orthogonal range query (Cirak, Knap & Ortiz, "Parallel
+// fragmentation with contact", the contact search section): a grid of buckets
+// in two directions u, v whose non-empty cells are kept in a sorted list, and
+// inside each cell the boxes sorted along the third direction w, searched by
+// bisection. Memory is O(number of boxes), independent of the bounding volume.
+//
+// Boxes of very different sizes are handled by levels: level l has cells of
+// side h_l = h_0 4^l and holds the boxes whose largest side is in
+// (h_{l-1}, h_l], so every box spans at most 2 x 2 cells of its level and the
+// w-extent of a cell's boxes is at most h_l. A single huge box sits alone on a
+// high level and costs every query O(1) cell visits, not O(area / h_0^2).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+/// Closed axis-aligned box [lo, hi], m.
+struct Box {
+  Vec3 lo;
+  Vec3 hi;
+};
+
+/// Closed-interval overlap: touching boxes overlap.
+inline bool boxes_overlap(const Box& a, const Box& b) {
+  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
+
+/// The search structure over a span of boxes (which the caller keeps alive and
+/// passes again to each query). Ids are positions in that span.
+///
+/// Layouts (L levels, C non-empty cells over all levels, N entries = box-cell
+/// incidences, N <= 4 x boxes):
+///   axis = {u, v, w}                w = the axis along which all boxes spread most
+///   origin[2]                       lowest lo along u and v
+///   cell_size[L]                    h_l = h_0 4^l; h_0 = 2 x the median largest box side
+///   level_cells[L+1]                cells of level l: [level_cells[l], level_cells[l+1])
+///   cell_key[C]                     (i << 32) | j, i = floor((x_u - origin_u) / h_l),
+///                                   ascending within a level
+///   cell_entries[C+1]               entries of cell c: [cell_entries[c], cell_entries[c+1])
+///   cell_max_extent[C]              max over the cell's boxes of hi_w - lo_w
+///   entry_lo[N]                     lo_w of the box, ascending within a cell (ties by id)
+///   entry_box[N]                    box id
+struct SparseBucket {
+  std::array<int, 3> axis = {0, 1, 2};
+  std::array<double, 2> origin = {0, 0};
+  std::vector<double> cell_size;
+  std::vector<Index> level_cells = {0};
+  std::vector<std::uint64_t> cell_key;
+  std::vector<Index> cell_entries = {0};
+  std::vector<double> cell_max_extent;
+  std::vector<double> entry_lo;
+  std::vector<Index> entry_box;
+
+  int num_levels() const { return static_cast<int>(cell_size.size()); }
+  /// Bucket index of coordinate x along grid axis k (0 = u, 1 = v) on level l;
+  /// monotone in x, so a box's cells are [cell(lo), cell(hi)].
+  std::uint32_t cell(int k, int l, double x) const {
+    const double s = std::floor((x - origin[k]) / cell_size[l]);
+    return static_cast<std::uint32_t>(std::clamp(s, 0.0, 2147483647.0));
+  }
+};
+
+/// Build the structure over `boxes` (oneTBB tasks; the result does not depend
+/// on the number of threads). No tuning parameter: h_0 follows the boxes.
+SparseBucket build_sparse_bucket(std::span<const Box> boxes);
+
+/// Bytes held by the structure's arrays (the boxes themselves not included).
+std::size_t memory_bytes(const SparseBucket& bucket);
+
+/// Call report(id) once for every box of `boxes` (the span the structure was
+/// built on) that overlaps q. Each pair is reported from one cell only: the
+/// cell that holds the lowest corner of the intersection, max(q.lo, box.lo).
+template <class Report>
+void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, const Box& q, Report&& report) {
+  const int u = b.axis[0], v = b.axis[1], w = b.axis[2];
+  constexpr double kRound = 4 * std::numeric_limits<double>::epsilon();
+  for (int l = 0; l < b.num_levels(); ++l) {
+    const std::uint64_t i0 = b.cell(0, l, q.lo[u]), i1 = b.cell(0, l, q.hi[u]);
+    const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
+    const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
+    // Walk only the non-empty cells of rows i0..i1, jumping over gaps by bisection.
+    auto it = std::lower_bound(first, last, (i0 << 32) | j0);
+    while (it != last) {
+      const std::uint64_t i = *it >> 32, j = *it & 0xffffffffu;
+      if (i > i1) break;
+      if (j < j0) {
+        it = std::lower_bound(it, last, (i << 32) | j0);
+        continue;
+      }
+      if (j > j1) {
+        it = std::lower_bound(it, last, ((i + 1) << 32) | j0);
+        continue;
+      }
+      const auto c = static_cast<Index>(it - b.cell_key.begin());
+      // Boxes with lo_w < q.lo_w - max extent end before q; the slack keeps
+      // the bisection conservative under rounding, the exact test decides.
+      const double m = b.cell_max_extent[c];
+      const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m);
+      const auto e_first = b.entry_lo.begin() + b.cell_entries[c];
+      const auto e_last = b.entry_lo.begin() + b.cell_entries[c + 1];
+      for (auto e = std::lower_bound(e_first, e_last, w_from); e != e_last && *e <= q.hi[w]; ++e) {
+        const Index id = b.entry_box[e - b.entry_lo.begin()];
+        const Box& x = boxes[id];
+        if (!boxes_overlap(q, x)) continue;
+        if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i && b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
+          report(id);
+      }
+      ++it;
+    }
+  }
+}
+
+}  // namespace shatter

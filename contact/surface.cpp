@@ -1,0 +1,128 @@
+#include "contact/surface.hpp"
+
+#include <algorithm>
+#include <iterator>
+
+#include "kernels/error.hpp"
+#include "kernels/tet10.hpp"
+
+namespace shatter {
+namespace {
+
+/// Outward faces of a positive tetrahedron (Gmsh corner order).
+constexpr std::array<std::array<int, 3>, 4> kOutwardFaces = {{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+
+/// Local TET10 node on the edge between corners i and j.
+int tet10_mid_node(int i, int j) {
+  for (int e = 0; e < 6; ++e) {
+    const auto [a, b] = kTet10Edges[e];
+    if ((a == i && b == j) || (a == j && b == i)) return 4 + e;
+  }
+  SHATTER_ASSERT(false);
+  return -1;
+}
+
+/// Local node triples of the sub-triangles of each outward face:
+/// TET4 one per face, TET10 four per face (corners a,b,c; mids ab, bc, ca).
+std::vector<std::array<int, 3>> face_triangles(int order, int face) {
+  const auto [a, b, c] = kOutwardFaces[face];
+  if (order == 1) return {{a, b, c}};
+  const int ab = tet10_mid_node(a, b), bc = tet10_mid_node(b, c), ca = tet10_mid_node(c, a);
+  return {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
+}
+
+/// Sorted unique edges {lo, hi} and vertices of a range of triangles.
+void triangle_edges_and_vertices(std::span<const SurfaceTriangle> triangles,
+                                 std::vector<std::array<Index, 2>>& edges, std::vector<Index>& vertices) {
+  edges.clear();
+  vertices.clear();
+  edges.reserve(3 * triangles.size());
+  vertices.reserve(3 * triangles.size());
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = t.nodes[k], b = t.nodes[(k + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b)});
+      vertices.push_back(a);
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+}
+
+/// sorted-unique `into` := sorted-unique union of `into` and `more`.
+template <class T>
+void merge_unique(std::vector<T>& into, const std::vector<T>& more) {
+  std::vector<T> merged;
+  merged.reserve(into.size() + more.size());
+  std::set_union(into.begin(), into.end(), more.begin(), more.end(), std::back_inserter(merged));
+  into.swap(merged);
+}
+
+}  // namespace
+
+ContactSurface build_contact_surface(const Mesh& mesh) {
+  SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "build_contact_surface: mesh order " << mesh.order
+                                                          << " (expected 1 = TET4 or 2 = TET10)");
+  // Every face as (sorted corner ids, element, local face); a face is on the
+  // boundary when its sorted key occurs once.
+  struct Face {
+    std::array<Index, 3> key;
+    Index elem;
+    int local;
+  };
+  const Index ne = mesh.num_elements();
+  std::vector<Face> faces;
+  faces.reserve(4 * static_cast<size_t>(ne));
+  for (Index e = 0; e < ne; ++e) {
+    const Index* n = mesh.element(e);
+    for (int f = 0; f < 4; ++f) {
+      std::array<Index, 3> key = {n[kOutwardFaces[f][0]], n[kOutwardFaces[f][1]], n[kOutwardFaces[f][2]]};
+      std::sort(key.begin(), key.end());
+      faces.push_back({key, e, f});
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
+    return std::tie(a.key, a.elem, a.local) < std::tie(b.key, b.elem, b.local);
+  });
+  std::vector<std::pair<Index, int>> boundary;  // (element, local face)
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    if (j - i == 1) boundary.emplace_back(faces[i].elem, faces[i].local);
+    i = j;
+  }
+  std::sort(boundary.begin(), boundary.end());
+
+  std::array<std::vector<std::array<int, 3>>, 4> local_triangles;
+  for (int f = 0; f < 4; ++f) local_triangles[f] = face_triangles(mesh.order, f);
+  std::vector<SurfaceTriangle> triangles;
+  triangles.reserve(boundary.size() * local_triangles[0].size());
+  for (const auto& [e, f] : boundary) {
+    const Index* n = mesh.element(e);
+    for (const auto& t : local_triangles[f]) triangles.push_back({{n[t[0]], n[t[1]], n[t[2]]}, mesh.elem_body[e]});
+  }
+  return make_contact_surface(triangles);
+}
+
+ContactSurface make_contact_surface(std::span<const SurfaceTriangle> triangles) {
+  ContactSurface s;
+  add_triangles(s, triangles);
+  return s;
+}
+
+void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> triangles) {
+  surface.triangles.reserve(surface.triangles.size() + triangles.size());
+  surface.body.reserve(surface.body.size() + triangles.size());
+  for (const auto& t : triangles) {
+    surface.triangles.push_back(t.nodes);
+    surface.body.push_back(t.body);
+  }
+  std::vector<std::array<Index, 2>> edges;
+  std::vector<Index> vertices;
+  triangle_edges_and_vertices(triangles, edges, vertices);
+  merge_unique(surface.edges, edges);
+  merge_unique(surface.vertices, vertices);
+}
+
+}  // namespace shatter

@@ -1,0 +1,67 @@
+#pragma once
+// The contact surface: the triangles, edges and vertices that the contact
+// search and DCR work on (DESIGN.md "The physics", step 2). Built once from
+// the volume mesh, then extended by the crack faces that fracture opens.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "kernels/types.hpp"
+#include "mesh/mesh.hpp"
+
+namespace shatter {
+
+/// Contact surface, struct of arrays. Node ids are the volume mesh's local
+/// node ids, so positions are read from arrays indexed by mesh node.
+///
+/// Layouts (t = triangles, e = edges, v = vertices):
+///   triangles[t] = {n0, n1, n2}   counter-clockwise seen from outside the body:
+///                                 (x1 - x0) x (x2 - x0) is the outward normal
+///   body[t]                       body id of the triangle (mesh.elem_body of its
+///                                 tetrahedron; the caller may overwrite it with a
+///                                 fragment id)
+///   edges[e] = {a, b}, a < b      every edge of a triangle once, sorted ascending
+///                                 lexicographically
+///   vertices[v]                   every node of a triangle once, ascending
+///
+/// TET10: each 6-node boundary face is split into its 4 sub-triangles
+/// (corner, mid, mid) x 3 and (mid, mid, mid), so every surface node, mid-edge
+/// nodes included, is a contact vertex and the piecewise-flat surface
+/// interpolates all surface nodes. The curved quadratic face is thus
+/// approximated by 4 flat triangles; the contact constraint acts on nodes.
+struct ContactSurface {
+  std::vector<std::array<Index, 3>> triangles;
+  std::vector<int> body;
+  std::vector<std::array<Index, 2>> edges;
+  std::vector<Index> vertices;
+
+  Index num_triangles() const { return static_cast<Index>(triangles.size()); }
+  Index num_edges() const { return static_cast<Index>(edges.size()); }
+  Index num_vertices() const { return static_cast<Index>(vertices.size()); }
+  friend bool operator==(const ContactSurface&, const ContactSurface&) = default;
+};
+
+/// A triangle to add to a surface: nodes counter-clockwise seen from outside,
+/// and its body (or fragment) id.
+struct SurfaceTriangle {
+  std::array<Index, 3> nodes;
+  int body;
+};
+
+/// Boundary of a tetrahedral mesh: the faces that belong to exactly one
+/// tetrahedron, oriented outward (mesh elements have positive volume in Gmsh
+/// node order, so the outward faces are (0,2,1), (0,1,3), (0,3,2), (1,2,3)).
+/// Triangles are listed by element, then local face (then sub-triangle for
+/// TET10). Cost O(E log E).
+ContactSurface build_contact_surface(const Mesh& mesh);
+
+/// Append triangles (e.g. crack faces opened by fracture) and update the
+/// vertex and edge lists incrementally: O((t + k) log k + e + v) for k new
+/// triangles, no rebuild from the mesh. The result equals
+/// make_contact_surface(old triangles followed by the new ones).
+void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> triangles);
+
+/// A surface made of the given triangles, in the given order.
+ContactSurface make_contact_surface(std::span<const SurfaceTriangle> triangles);
+
+}  // namespace shatter
