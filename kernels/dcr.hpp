@@ -1,0 +1,381 @@
+#pragma once
+// Decomposition contact response (DCR) on one contact pair: Cirak & West,
+// "Decomposition contact response (DCR) for explicit finite element
+// dynamics", IJNME 64 (2005) 1078-1110 (below: [CW]).
+//
+// A pair is four surface nodes, the columns of a PairPoints matrix:
+//   VertexFace: {p, a, b, c}   (triangle a-b-c counter-clockwise seen from outside)
+//   EdgeEdge:   {a0, a1, b0, b1}
+// The constraint is the signed volume of the tetrahedron of the four points
+// ([CW] sec. 2.2), g = s V with
+//   V(x) = (x1 - x0) . ((x2 - x0) x (x3 - x0)) / 6                      [m^3]
+// and the orientation s chosen so that g > 0 is admissible: for a vertex and
+// a face s = -1, i.e. g = ((b - a) x (c - a)) . (p - a) / 6 > 0 when p is on
+// the outer side; for two edges s is the sign of V at the start of the step.
+// g is invariant under translations and rotations of the four points, so
+// sum_i grad_i g = 0 and sum_i x_i x grad_i g = 0: impulses along grad g (and
+// along the gradient of any such function) conserve linear and angular
+// momentum exactly ([CW] sec. 3).
+//
+// Per pair and step, with positions moving linearly from X_old to X_new:
+//   1. detection (dcr_detect): g(t) is a cubic in t; the pair penetrates when g
+//      ends negative and the stretch of negative g began (g(t*) = 0) with the
+//      vertex inside the triangle / the two segments crossing at t*;
+//   2. projection (dcr_project): x_i += mu W_i grad_i g (W = M^-1, the inverse
+//      lumped masses; W_i = 0 is a fixed node), mu > 0 the smallest root of
+//      g(mu) = gap target (a cubic in mu), so the pair's centre of mass stays;
+//   3. momentum decomposition (dcr_impulse), [CW] sec. 3-4: normal part
+//      v_n = grad g . v / (grad g . W grad g), v' = v - (1 + e) v_n W grad g,
+//      then Coulomb friction as a second decomposition along a slide direction.
+// Pure functions: no allocation, no threads, no I/O.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+/// The four points (columns, m) or velocities (m/s) of one contact pair.
+using PairPoints = Eigen::Matrix<double, 3, 4>;
+/// One value per node of a pair, e.g. the inverse lumped masses (1/kg; 0 = fixed node).
+using PairWeights = Eigen::Vector4d;
+
+enum class DcrPairKind : std::uint8_t { VertexFace = 0, EdgeEdge = 1 };
+
+/// Contact law of the DCR response.
+struct DcrLaw {
+  double restitution = 1.0;  ///< e in [0, 1]: 1 = elastic, 0 = perfectly plastic
+  double friction = 0.0;     ///< Coulomb coefficient mu >= 0
+  double gap = 1e-6;         ///< separation left after projection, as a fraction of the
+                             ///< pair's longest edge (dimensionless)
+};
+
+/// |g| below kDcrVolumeTolerance L^3 (L the pair's longest edge) counts as touching.
+inline constexpr double kDcrVolumeTolerance = 1e-10;
+/// Barycentric / segment-parameter slack of the inside tests (dimensionless), so a
+/// vertex crossing exactly on an edge shared by two triangles is caught by both.
+inline constexpr double kDcrInsideTolerance = 1e-9;
+/// Edges with sin^2(angle) below this are parallel: their volume vanishes
+/// identically and the vertex-face pairs of their end points carry the contact.
+inline constexpr double kDcrParallelTolerance = 1e-12;
+
+/// V(X) = (x1 - x0) . ((x2 - x0) x (x3 - x0)) / 6, m^3.
+inline double pair_volume(const PairPoints& X) {
+  return (X.col(1) - X.col(0)).dot((X.col(2) - X.col(0)).cross(X.col(3) - X.col(0))) / 6.0;
+}
+
+/// Exact gradient of pair_volume, columns dV/dx_i (m^2):
+///   dV/dx1 = e2 x e3 / 6, dV/dx2 = e3 x e1 / 6, dV/dx3 = e1 x e2 / 6,
+///   dV/dx0 = -(dV/dx1 + dV/dx2 + dV/dx3),   e_k = x_k - x0.
+inline PairPoints pair_volume_gradient(const PairPoints& X) {
+  const Vec3 e1 = X.col(1) - X.col(0), e2 = X.col(2) - X.col(0), e3 = X.col(3) - X.col(0);
+  PairPoints G;
+  G.col(1) = e2.cross(e3) / 6.0;
+  G.col(2) = e3.cross(e1) / 6.0;
+  G.col(3) = e1.cross(e2) / 6.0;
+  G.col(0) = -(G.col(1) + G.col(2) + G.col(3));
+  return G;
+}
+
+/// Longest edge of the pair's primitives (the triangle, or the two edges), m.
+inline double pair_length_scale(DcrPairKind kind, const PairPoints& X) {
+  if (kind == DcrPairKind::VertexFace)
+    return std::sqrt(std::max({(X.col(2) - X.col(1)).squaredNorm(), (X.col(3) - X.col(2)).squaredNorm(),
+                               (X.col(1) - X.col(3)).squaredNorm()}));
+  return std::sqrt(std::max((X.col(1) - X.col(0)).squaredNorm(), (X.col(3) - X.col(2)).squaredNorm()));
+}
+
+/// |n| of the primitives' normal n = (b - a) x (c - a) (VF) or (a1 - a0) x (b1 - b0)
+/// (EE), m^2: the distance of the pair is 6 |g| / |n|.
+inline double pair_normal_norm(DcrPairKind kind, const PairPoints& X) {
+  if (kind == DcrPairKind::VertexFace) return (X.col(2) - X.col(1)).cross(X.col(3) - X.col(1)).norm();
+  return (X.col(1) - X.col(0)).cross(X.col(3) - X.col(2)).norm();
+}
+
+/// Orientation s of the constraint g = s V: -1 for a vertex and a face; for two
+/// edges the sign of V at the start of the step, or, when they start touching,
+/// the side they came from: -sign(V(X_new)) (so moving through counts as penetration).
+inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
+  if (kind == DcrPairKind::VertexFace) return -1.0;
+  const double L = pair_length_scale(kind, X_old);
+  const double V0 = pair_volume(X_old);
+  if (std::abs(V0) > kDcrVolumeTolerance * L * L * L) return V0 > 0 ? 1.0 : -1.0;
+  return pair_volume(X_new) > 0 ? -1.0 : 1.0;
+}
+
+/// A cubic c0 + c1 t + c2 t^2 + c3 t^3.
+struct DcrCubic {
+  double c0, c1, c2, c3;
+  double operator()(double t) const { return ((c3 * t + c2) * t + c1) * t + c0; }
+};
+
+/// V(X + t D) as a cubic in t, exactly: the determinant of three columns linear in t.
+inline DcrCubic pair_volume_along(const PairPoints& X, const PairPoints& D) {
+  const Vec3 u0 = X.col(1) - X.col(0), v0 = X.col(2) - X.col(0), w0 = X.col(3) - X.col(0);
+  const Vec3 u1 = D.col(1) - D.col(0), v1 = D.col(2) - D.col(0), w1 = D.col(3) - D.col(0);
+  auto det = [](const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); };
+  return {det(u0, v0, w0) / 6.0, (det(u1, v0, w0) + det(u0, v1, w0) + det(u0, v0, w1)) / 6.0,
+          (det(u1, v1, w0) + det(u1, v0, w1) + det(u0, v1, w1)) / 6.0, det(u1, v1, w1) / 6.0};
+}
+
+/// Break points of [lo, hi] into pieces on which p is monotone: lo, the real roots of
+/// p' inside (lo, hi) in ascending order, hi. Returns the number of points (2..4).
+inline int dcr_monotone_breaks(const DcrCubic& p, double lo, double hi, std::array<double, 4>& t) {
+  // p'(t) = a t^2 + b t + c; the stable quadratic formula avoids cancellation.
+  const double a = 3.0 * p.c3, b = 2.0 * p.c2, c = p.c1;
+  std::array<double, 2> r{};
+  int nr = 0;
+  if (a == 0.0) {
+    if (b != 0.0) r[nr++] = -c / b;
+  } else {
+    const double disc = b * b - 4.0 * a * c;
+    if (disc >= 0.0) {
+      const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+      r[nr++] = q / a;
+      if (q != 0.0) r[nr++] = c / q;
+    }
+  }
+  if (nr == 2 && r[1] < r[0]) std::swap(r[0], r[1]);
+  int n = 0;
+  t[n++] = lo;
+  for (int k = 0; k < nr; ++k)
+    if (r[k] > lo && r[k] < hi) t[n++] = r[k];
+  t[n++] = hi;
+  return n;
+}
+
+/// Bisection on [a, b] where p(a) and p(b) lie on different sides of 0 (p(a) < 0 <= p(b)
+/// or p(b) < 0 <= p(a)), down to adjacent doubles; returns the end on p(b)'s side.
+inline double dcr_bisect(const DcrCubic& p, double a, double b) {
+  const bool a_negative = p(a) < 0.0;
+  for (int it = 0; it < 200; ++it) {
+    const double m = 0.5 * (a + b);
+    if (m == a || m == b) break;
+    if ((p(m) < 0.0) == a_negative) a = m;
+    else b = m;
+  }
+  return b;
+}
+
+/// Outcome of the narrow phase on one pair over one step.
+struct DcrPenetration {
+  bool penetrating = false;
+  double time = 0.0;         ///< t* in [0, 1]: start of the final stretch with g < 0
+  double orientation = 1.0;  ///< s of g = s V
+};
+
+/// Whether the pair penetrated during the step, positions moving linearly from X_old
+/// (t = 0) to X_new (t = 1). Penetration: g(X_new) < -tol, and at the time t* where the
+/// final stretch of negative g begins (g(t*) = 0, found on the monotone pieces of the
+/// cubic g(t), or t* = 0 when the pair starts touching, |g| <= tol) the vertex lies in
+/// the triangle (barycentric coordinates >= -kDcrInsideTolerance) / the two segments
+/// cross (both line parameters in [-tol, 1 + tol], the edges not parallel).
+/// Robust for fast motion (exact cubic in t, no sampling), grazing (g touches 0 and
+/// returns: g(X_new) > -tol), touching at the end (|g| <= tol) and degenerate
+/// geometry (zero-area triangles and parallel edges are left to neighbouring pairs).
+/// tol = kDcrVolumeTolerance L^3, L from pair_length_scale(X_old).
+inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
+  DcrPenetration out;
+  out.orientation = dcr_orientation(kind, X_old, X_new);
+  const double s = out.orientation;
+  const double L = pair_length_scale(kind, X_old);
+  const double tol = kDcrVolumeTolerance * L * L * L;
+  if (!(s * pair_volume(X_new) < -tol)) return out;
+
+  DcrCubic g = pair_volume_along(X_old, X_new - X_old);
+  g = {s * g.c0, s * g.c1, s * g.c2, s * g.c3};
+  std::array<double, 4> br;
+  const int n = dcr_monotone_breaks(g, 0.0, 1.0, br);
+  double t_star = -1.0;
+  for (int k = n - 2; k >= 0; --k) {
+    const double ga = g(br[k]);
+    if (ga >= 0.0) {
+      t_star = g(br[k + 1]) < 0.0 ? dcr_bisect(g, br[k + 1], br[k]) : br[k + 1];
+      break;
+    }
+    if (k == 0 && ga >= -tol) t_star = 0.0;
+  }
+  if (t_star < 0.0) return out;  // behind the face / the other edge all step long
+
+  const PairPoints X = X_old + t_star * (X_new - X_old);
+  if (kind == DcrPairKind::VertexFace) {
+    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), w = X.col(0) - X.col(1);
+    const Vec3 nrm = e1.cross(e2);
+    const double nn = nrm.squaredNorm();
+    if (!(nn > kDcrParallelTolerance * e1.squaredNorm() * e2.squaredNorm())) return out;
+    const double lb = w.cross(e2).dot(nrm) / nn, lc = e1.cross(w).dot(nrm) / nn;
+    const double la = 1.0 - lb - lc;
+    if (la < -kDcrInsideTolerance || lb < -kDcrInsideTolerance || lc < -kDcrInsideTolerance) return out;
+  } else {
+    const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), w = X.col(0) - X.col(2);
+    const double aa = ea.dot(ea), ab = ea.dot(eb), bb = eb.dot(eb), aw = ea.dot(w), bw = eb.dot(w);
+    const double den = aa * bb - ab * ab;
+    if (!(den > kDcrParallelTolerance * aa * bb)) return out;
+    const double sa = (ab * bw - bb * aw) / den, sb = (aa * bw - ab * aw) / den;
+    const double lo = -kDcrInsideTolerance, hi = 1.0 + kDcrInsideTolerance;
+    if (sa < lo || sa > hi || sb < lo || sb > hi) return out;
+  }
+  out.penetrating = true;
+  out.time = t_star;
+  return out;
+}
+
+/// Removes the penetration of a pair in place by the mass-weighted projection
+///   x_i <- x_i + mu W_i grad_i g(X),  mu > 0,
+/// with g(mu) = g_target = gap L |n| / 6 (a separation of gap L, L and |n| from
+/// pair_length_scale and pair_normal_norm at X): the smallest positive root of this
+/// cubic in mu. The direction is M^-1 grad g, so sum_i m_i dx_i = 0 (the pair's centre of
+/// mass does not move) and nodes with W_i = 0 stay put ([CW] sec. 4, closest-point
+/// projection in the mass metric). When the cubic has no root in reach, the step goes to
+/// its maximum and the gradient is re-evaluated (at most 4 passes).
+/// Returns whether g(X) > 0 afterwards (false e.g. when all four nodes are fixed).
+inline bool dcr_project(DcrPairKind kind, double orientation, PairPoints& X, const PairWeights& inv_mass,
+                        double gap) {
+  const double s = orientation;
+  const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
+  for (int pass = 0; pass < 4; ++pass) {
+    const PairPoints G = s * pair_volume_gradient(X);
+    PairPoints D = G;
+    for (int i = 0; i < 4; ++i) D.col(i) *= inv_mass[i];
+    const double q = (G.array() * D.array()).sum();
+    if (!(q > 0.0)) return false;
+    DcrCubic g = pair_volume_along(X, D);
+    g = {s * g.c0 - target, s * g.c1, s * g.c2, s * g.c3};
+    if (g.c0 >= 0.0) return true;
+    const double hi = 16.0 * (-g.c0 / q);
+    std::array<double, 4> br;
+    const int n = dcr_monotone_breaks(g, 0.0, hi, br);
+    double mu = 0.0;
+    for (int k = 0; k + 1 < n; ++k) {
+      if (g(br[k + 1]) >= 0.0) {
+        mu = dcr_bisect(g, br[k], br[k + 1]);
+        break;
+      }
+      if (g(br[k + 1]) > g(mu)) mu = br[k + 1];
+    }
+    X += mu * D;
+    if (g(mu) >= 0.0) break;
+  }
+  return s * pair_volume(X) > 0.0;
+}
+
+/// The momentum transfer of one resolved pair.
+struct DcrImpulse {
+  double normal = 0.0;      ///< |normal impulse| on the vertex / on edge a, N s
+  double friction = 0.0;    ///< |slide impulse| on the vertex / on edge a, N s
+  double dissipated = 0.0;  ///< kinetic energy lost, J (>= 0; 0 for e = 1, mu = 0)
+  bool stick = false;       ///< friction stopped the sliding
+};
+
+/// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
+/// "Solving the collision equations"), V (columns, m/s) updated in place.
+/// Normal: with G = grad g(X), W = M^-1 (inv_mass, 0 = fixed node),
+///   v_n = G . V / (G . W G)  [kg m/s];  if v_n < 0 (approaching):
+///   V' = V - (1 + e) v_n W G,  dissipated = (1 - e^2) v_n^2 (G . W G) / 2.
+/// Friction: the contact point splits as sum_i c_i x_i (vertex minus the barycentric point
+/// of the face; or the closest points of the two edges), with sum c_i = 0 and sum over the
+/// vertex / edge a of c_i = 1. Its tangential relative velocity gives the slide direction
+/// t = sum_i d_i x_i (d_i from the two edge vectors spanning the tangent plane, sum d_i = 0);
+/// the slide generator F is the gradient of the translation- and rotation-invariant
+/// phi = (sum c_i x_i) . (sum d_i x_i), made W-orthogonal to G (so the normal part is left
+/// alone): zero net force and zero net torque, exactly. Slide decomposition
+///   v_s = F . V / (F . W F);  needed impulse v_s, limit mu J_n / |sum_A F_i|
+/// (J_n = normal impulse on side A = the vertex / edge a); stick when within the limit,
+/// else slide with the limit: V' = V - j W F, dissipated j (F . W F) (v_s - j / 2).
+inline DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X, PairPoints& V,
+                              const PairWeights& inv_mass, const DcrLaw& law) {
+  DcrImpulse out;
+  const PairPoints G = orientation * pair_volume_gradient(X);
+  PairPoints D = G;
+  for (int i = 0; i < 4; ++i) D.col(i) *= inv_mass[i];
+  const double q = (G.array() * D.array()).sum();
+  if (!(q > 0.0)) return out;
+  const double v_n = (G.array() * V.array()).sum() / q;
+  if (!(v_n < 0.0)) return out;  // already separating
+  const double e = law.restitution;
+  V -= ((1.0 + e) * v_n) * D;
+  out.dissipated = 0.5 * (1.0 - e * e) * v_n * v_n * q;
+  const int side_a = kind == DcrPairKind::VertexFace ? 1 : 2;  // nodes 0..side_a-1
+  const Vec3 G_a = G.leftCols(side_a).rowwise().sum();
+  out.normal = -(1.0 + e) * v_n * G_a.norm();
+  if (!(law.friction > 0.0)) return out;
+
+  // Contact point coefficients c, tangent basis e1 = sum d1_i x_i, e2 = sum d2_i x_i, normal.
+  PairWeights c, d1, d2;
+  Vec3 nrm;
+  if (kind == DcrPairKind::VertexFace) {
+    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), w = X.col(0) - X.col(1);
+    nrm = e1.cross(e2);
+    const double nn = nrm.squaredNorm();
+    if (!(nn > 0.0)) return out;
+    const double lb = w.cross(e2).dot(nrm) / nn, lc = e1.cross(w).dot(nrm) / nn;
+    c << 1.0, -(1.0 - lb - lc), -lb, -lc;
+    d1 << 0.0, -1.0, 1.0, 0.0;
+    d2 << 0.0, -1.0, 0.0, 1.0;
+  } else {
+    const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), w = X.col(0) - X.col(2);
+    nrm = ea.cross(eb);
+    const double aa = ea.dot(ea), ab = ea.dot(eb), bb = eb.dot(eb), aw = ea.dot(w), bw = eb.dot(w);
+    const double den = aa * bb - ab * ab;
+    if (!(den > 0.0)) return out;
+    const double sa = std::clamp((ab * bw - bb * aw) / den, 0.0, 1.0);
+    const double sb = std::clamp((aa * bw - ab * aw) / den, 0.0, 1.0);
+    c << 1.0 - sa, sa, -(1.0 - sb), -sb;
+    d1 << -1.0, 1.0, 0.0, 0.0;
+    d2 << 0.0, 0.0, -1.0, 1.0;
+  }
+  const Vec3 n_hat = nrm.normalized();
+  const Vec3 v_rel = V * c;
+  const Vec3 v_t = v_rel - v_rel.dot(n_hat) * n_hat;
+  const double v_scale = V.colwise().norm().maxCoeff();
+  if (!(v_t.norm() > 1e-14 * v_scale)) return out;  // no sliding
+  const Vec3 t_hat = v_t.normalized();
+  const Vec3 e1 = X * d1, e2 = X * d2;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  const double alpha = (g22 * e1.dot(t_hat) - g12 * e2.dot(t_hat)) / det;
+  const double beta = (g11 * e2.dot(t_hat) - g12 * e1.dot(t_hat)) / det;
+  const PairWeights d = alpha * d1 + beta * d2;
+  const Vec3 r = X * c, t = X * d;
+  PairPoints F = t * c.transpose() + r * d.transpose();  // grad of phi = r . t
+  F -= ((F.array() * D.array()).sum() / q) * G;
+  PairPoints DF = F;
+  for (int i = 0; i < 4; ++i) DF.col(i) *= inv_mass[i];
+  const double qf = (F.array() * DF.array()).sum();
+  if (!(qf > 0.0)) return out;
+  const double v_s = (F.array() * V.array()).sum() / qf;
+  if (!(v_s > 0.0)) return out;
+  const double F_a = F.leftCols(side_a).rowwise().sum().norm();
+  const double j_max = law.friction * out.normal / F_a;
+  out.stick = v_s <= j_max;
+  const double j = out.stick ? v_s : j_max;
+  V -= j * DF;
+  out.friction = j * F_a;
+  out.dissipated += j * qf * (v_s - 0.5 * j);
+  return out;
+}
+
+/// Outcome of dcr_resolve_pair.
+struct DcrPairResponse {
+  bool active = false;  ///< the pair penetrated and was resolved
+  bool separated = false;  ///< the projection reached g > 0
+  DcrImpulse impulse;
+};
+
+/// One DCR resolution of a pair over a step: detect (dcr_detect on X_old -> X_new); if it
+/// penetrates, project X_new (dcr_project) and update the velocities V at the projected
+/// positions (dcr_impulse). X_new and V are updated in place.
+inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new,
+                                        PairPoints& V, const PairWeights& inv_mass, const DcrLaw& law) {
+  DcrPairResponse out;
+  const DcrPenetration pen = dcr_detect(kind, X_old, X_new);
+  if (!pen.penetrating) return out;
+  out.active = true;
+  out.separated = dcr_project(kind, pen.orientation, X_new, inv_mass, law.gap);
+  out.impulse = dcr_impulse(kind, pen.orientation, X_new, V, inv_mass, law);
+  return out;
+}
+
+}  // namespace shatter

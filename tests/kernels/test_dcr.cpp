@@ -1,0 +1,489 @@
+// DCR pair kernels (kernels/dcr.hpp): the volume constraint and its gradient,
+// penetration detection over a step, mass-weighted projection, and the momentum
+// decompositions (normal impact with restitution, Coulomb friction).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "expect_close.hpp"
+#include "kernels/dcr.hpp"
+
+using namespace shatter;
+
+namespace {
+
+constexpr auto VF = DcrPairKind::VertexFace;
+constexpr auto EE = DcrPairKind::EdgeEdge;
+
+PairPoints points(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
+  PairPoints X;
+  X << x0, x1, x2, x3;
+  return X;
+}
+
+PairPoints random_points(std::mt19937_64& rng, double scale = 1.0) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  PairPoints X;
+  for (int i = 0; i < 4; ++i) X.col(i) = scale * Vec3(u(rng), u(rng), u(rng));
+  return X;
+}
+
+PairWeights random_inv_mass(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.2, 5.0);
+  return PairWeights(1 / u(rng), 1 / u(rng), 1 / u(rng), 1 / u(rng));
+}
+
+struct Ledger {
+  Vec3 p = Vec3::Zero(), L = Vec3::Zero();
+  double kinetic = 0, p_scale = 0, L_scale = 0;
+};
+
+Ledger ledger(const PairPoints& X, const PairPoints& V, const PairWeights& w) {
+  Ledger out;
+  for (int i = 0; i < 4; ++i) {
+    const double m = 1 / w[i];
+    out.p += m * V.col(i);
+    out.L += m * X.col(i).cross(V.col(i));
+    out.kinetic += 0.5 * m * V.col(i).squaredNorm();
+    out.p_scale += m * V.col(i).norm();
+    out.L_scale += m * X.col(i).norm() * V.col(i).norm();
+  }
+  return out;
+}
+
+double vf_constraint(const PairPoints& X) { return -pair_volume(X); }
+
+// Unit triangle in z = 0, counter-clockwise seen from +z (outside is +z).
+const Vec3 kA(0, 0, 0), kB(1, 0, 0), kC(0, 1, 0);
+
+}  // namespace
+
+TEST(DcrGeometry, VertexFaceSignIsPositiveOutside) {
+  const PairPoints above = points(Vec3(0.2, 0.2, 0.3), kA, kB, kC);
+  EXPECT_NEAR(vf_constraint(above), 0.5 * 0.3 / 3.0, 1e-16);  // area h / 3
+  EXPECT_NEAR(vf_constraint(points(Vec3(0.2, 0.2, -0.3), kA, kB, kC)), -0.05, 1e-16);
+  EXPECT_EQ(dcr_orientation(VF, above, above), -1.0);
+}
+
+TEST(DcrGeometry, GradientMatchesFiniteDifferences) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 20; ++trial) {
+    const PairPoints X = random_points(rng);
+    const PairPoints G = pair_volume_gradient(X);
+    const double h = 1e-6;
+    for (int i = 0; i < 4; ++i)
+      for (int d = 0; d < 3; ++d) {
+        PairPoints Xp = X, Xm = X;
+        Xp(d, i) += h;
+        Xm(d, i) -= h;
+        const double fd = (pair_volume(Xp) - pair_volume(Xm)) / (2 * h);
+        // V is cubic: central differences err by h^2 times third derivatives (O(1) here).
+        EXPECT_NEAR(G(d, i), fd, 1e-9 * G.norm()) << "node " << i << " dir " << d;
+      }
+  }
+}
+
+TEST(DcrGeometry, GradientHasZeroNetForceAndTorque) {
+  std::mt19937_64 rng(12);
+  for (int trial = 0; trial < 50; ++trial) {
+    const PairPoints X = random_points(rng, 10.0);
+    const PairPoints G = pair_volume_gradient(X);
+    Vec3 torque = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) torque += X.col(i).cross(G.col(i));
+    EXPECT_LT(G.rowwise().sum().norm(), 1e-15 * G.norm());
+    EXPECT_LT(torque.norm(), 1e-15 * X.norm() * G.norm());
+  }
+}
+
+TEST(DcrGeometry, VolumeAlongIsExactCubic) {
+  std::mt19937_64 rng(13);
+  const PairPoints X = random_points(rng), D = random_points(rng);
+  const DcrCubic g = pair_volume_along(X, D);
+  for (double t : {-1.5, 0.0, 0.3, 1.0, 2.0})
+    EXPECT_NEAR(g(t), pair_volume(X + t * D), 1e-14 * (1 + std::abs(t * t * t)));
+}
+
+// --- detection -------------------------------------------------------------------------
+
+TEST(DcrDetect, VertexCrossingTheFace) {
+  const PairPoints X0 = points(Vec3(0.2, 0.2, 0.5), kA, kB, kC);
+  const PairPoints X1 = points(Vec3(0.2, 0.2, -0.1), kA, kB, kC);
+  const DcrPenetration p = dcr_detect(VF, X0, X1);
+  EXPECT_TRUE(p.penetrating);
+  EXPECT_NEAR(p.time, 0.5 / 0.6, 1e-15);
+}
+
+TEST(DcrDetect, VertexPassingBesideTheFace) {
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.6, 0.6, 0.5), kA, kB, kC), points(Vec3(0.6, 0.6, -0.1), kA, kB, kC))
+                   .penetrating);
+  // Just outside the hypotenuse, beyond the inside tolerance.
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.5 + 1e-6, 0.5, 0.5), kA, kB, kC),
+                          points(Vec3(0.5 + 1e-6, 0.5, -0.1), kA, kB, kC))
+                   .penetrating);
+}
+
+TEST(DcrDetect, VertexThroughAnEdgeIsCaughtByBothTriangles) {
+  // Hits the shared edge a-b exactly; the neighbour b-a-d lies on the other side.
+  const Vec3 d(0.5, -1, 0);
+  const PairPoints Xo = points(Vec3(0.5, 0, 0.5), kA, kB, kC), Xn = points(Vec3(0.5, 0, -0.5), kA, kB, kC);
+  EXPECT_TRUE(dcr_detect(VF, Xo, Xn).penetrating);
+  EXPECT_TRUE(dcr_detect(VF, points(Vec3(0.5, 0, 0.5), kB, kA, d), points(Vec3(0.5, 0, -0.5), kB, kA, d))
+                  .penetrating);
+}
+
+TEST(DcrDetect, GrazingAndTouchingAreNotPenetrations) {
+  // Sliding in the plane of the face: g = 0 all step.
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(-0.5, 0.2, 0), kA, kB, kC), points(Vec3(0.8, 0.1, 0), kA, kB, kC))
+                   .penetrating);
+  // Coming to rest exactly on the face.
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.2, 0.2, 0.5), kA, kB, kC), points(Vec3(0.2, 0.2, 0), kA, kB, kC))
+                   .penetrating);
+  // Stopping a round-off above it.
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.2, 0.2, 0.5), kA, kB, kC), points(Vec3(0.2, 0.2, 1e-13), kA, kB, kC))
+                   .penetrating);
+  // The face tilts up to touch the vertex mid-step while the vertex slides on: with
+  // c = (0, 1, t) and p = (0.2, 1 - t, h), g ~ h - t (1 - t) has a double root at t = 1/2
+  // for h = 1/4 (a graze), two roots for h slightly less (in and out again).
+  for (const double h : {0.25, 0.25 - 1e-3}) {
+    const PairPoints Xo = points(Vec3(0.2, 1, h), kA, kB, Vec3(0, 1, 0));
+    const PairPoints Xn = points(Vec3(0.2, 0, h), kA, kB, Vec3(0, 1, 1));
+    EXPECT_FALSE(dcr_detect(VF, Xo, Xn).penetrating) << "h = " << h;
+  }
+}
+
+TEST(DcrDetect, StartingBehindTheFaceIsNotAPenetration) {
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.2, 0.2, -0.5), kA, kB, kC), points(Vec3(0.2, 0.2, -0.6), kA, kB, kC))
+                   .penetrating);
+  EXPECT_FALSE(dcr_detect(VF, points(Vec3(0.2, 0.2, -0.5), kA, kB, kC), points(Vec3(0.2, 0.2, 0.5), kA, kB, kC))
+                   .penetrating);
+}
+
+TEST(DcrDetect, StartingInContactAndMovingInIsAPenetration) {
+  const DcrPenetration p =
+      dcr_detect(VF, points(Vec3(0.2, 0.2, 0), kA, kB, kC), points(Vec3(0.2, 0.2, -0.01), kA, kB, kC));
+  EXPECT_TRUE(p.penetrating);
+  EXPECT_EQ(p.time, 0.0);
+}
+
+TEST(DcrDetect, FastMotionDoesNotTunnel) {
+  const DcrPenetration vf =
+      dcr_detect(VF, points(Vec3(0.1, 0.3, 1e3), kA, kB, kC), points(Vec3(0.3, 0.1, -1e3), kA, kB, kC));
+  EXPECT_TRUE(vf.penetrating);
+  EXPECT_NEAR(vf.time, 0.5, 1e-14);
+  const PairPoints Xo = points(Vec3(-1, 0, 1e4), Vec3(1, 0, 1e4), Vec3(0, -1, 0), Vec3(0, 1, 0));
+  const PairPoints Xn = points(Vec3(-1, 0, -1e4), Vec3(1, 0, -1e4), Vec3(0, -1, 0), Vec3(0, 1, 0));
+  EXPECT_TRUE(dcr_detect(EE, Xo, Xn).penetrating);
+  // Both moving fast: the face overtakes the vertex.
+  const Vec3 up(0, 0, 1e3);
+  EXPECT_TRUE(dcr_detect(VF, points(Vec3(0.2, 0.2, 1), kA, kB, kC), points(Vec3(0.2, 0.2, 1), kA + up, kB + up, kC + up))
+                  .penetrating);
+}
+
+TEST(DcrDetect, RotatingFaceSweepsThroughTheVertex) {
+  // The face tilts about the edge a-b: c goes from above the vertex's height to below,
+  // while the vertex stays put: a cubic g(t) with the root inside the face.
+  const Vec3 p(0.1, 0.2, 0.05);
+  const PairPoints Xo = points(p, kA, kB, Vec3(0, 1, -0.5)), Xn = points(p, kA, kB, Vec3(0, 1, 0.5));
+  const DcrPenetration pen = dcr_detect(VF, Xo, Xn);
+  EXPECT_TRUE(pen.penetrating);
+  const PairPoints Xt = Xo + pen.time * (Xn - Xo);
+  EXPECT_NEAR(pair_volume(Xt), 0.0, 1e-15);
+}
+
+TEST(DcrDetect, EdgesCrossing) {
+  const PairPoints Xo = points(Vec3(-1, 0.1, 0.1), Vec3(1, 0.1, 0.1), Vec3(0.2, -1, 0), Vec3(0.2, 1, 0));
+  const PairPoints Xn = points(Vec3(-1, 0.1, -0.3), Vec3(1, 0.1, -0.3), Vec3(0.2, -1, 0), Vec3(0.2, 1, 0));
+  const DcrPenetration p = dcr_detect(EE, Xo, Xn);
+  EXPECT_TRUE(p.penetrating);
+  EXPECT_NEAR(p.time, 0.25, 1e-15);
+  // The same with edge b reversed: the orientation follows the start of the step.
+  PairPoints Yo = Xo, Yn = Xn;
+  Yo.col(2).swap(Yo.col(3));
+  Yn.col(2).swap(Yn.col(3));
+  const DcrPenetration q = dcr_detect(EE, Yo, Yn);
+  EXPECT_TRUE(q.penetrating);
+  EXPECT_EQ(q.orientation, -p.orientation);
+}
+
+TEST(DcrDetect, EdgesMissingEachOther) {
+  // The lines cross at x = 0.2, outside edge a = [0.5, 1.5].
+  const PairPoints Xo = points(Vec3(0.5, 0, 0.1), Vec3(1.5, 0, 0.1), Vec3(0.2, -1, 0), Vec3(0.2, 1, 0));
+  const PairPoints Xn = points(Vec3(0.5, 0, -0.1), Vec3(1.5, 0, -0.1), Vec3(0.2, -1, 0), Vec3(0.2, 1, 0));
+  EXPECT_FALSE(dcr_detect(EE, Xo, Xn).penetrating);
+}
+
+TEST(DcrDetect, ParallelEdgesAreLeftToTheVertexFacePairs) {
+  const PairPoints Xo = points(Vec3(-1, 0, 0.1), Vec3(1, 0, 0.1), Vec3(-1, 0.5, 0), Vec3(1, 0.5, 0));
+  const PairPoints Xn = points(Vec3(-1, 1, -0.1), Vec3(1, 1, -0.1), Vec3(-1, 0.5, 0), Vec3(1, 0.5, 0));
+  EXPECT_FALSE(dcr_detect(EE, Xo, Xn).penetrating);
+  // Nearly parallel (1e-8 rad) and crossing: the volume stays below the touching tolerance.
+  PairPoints Yn = Xn;
+  Yn.col(1).y() += 2e-8;
+  EXPECT_FALSE(dcr_detect(EE, Xo, Yn).penetrating);
+}
+
+TEST(DcrDetect, EdgesTouchingAtTheEndAreNotPenetrating) {
+  const PairPoints Xo = points(Vec3(-1, 0, 0.1), Vec3(1, 0, 0.1), Vec3(0, -1, 0), Vec3(0, 1, 0));
+  const PairPoints Xn = points(Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0));
+  EXPECT_FALSE(dcr_detect(EE, Xo, Xn).penetrating);
+}
+
+// --- projection ------------------------------------------------------------------------
+
+TEST(DcrProject, RemovesPenetrationKeepsCentreOfMassAndFixedNodes) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 200; ++trial) {
+    const DcrPairKind kind = trial % 2 ? EE : VF;
+    const PairPoints Xo = random_points(rng);
+    const PairPoints Xn = Xo + 0.8 * random_points(rng);
+    const DcrPenetration pen = dcr_detect(kind, Xo, Xn);
+    if (!pen.penetrating) continue;
+    PairWeights w = random_inv_mass(rng);
+    if (trial % 3 == 0) w[1] = 0;  // a fixed node
+    PairPoints X = Xn;
+    ASSERT_TRUE(dcr_project(kind, pen.orientation, X, w, 1e-6));
+    const double target = 1e-6 * pair_length_scale(kind, Xn) * pair_normal_norm(kind, Xn) / 6;
+    EXPECT_GT(pen.orientation * pair_volume(X), 0.0);
+    EXPECT_CLOSE(pen.orientation * pair_volume(X), target, 1e-6, 0);
+    if (w[1] == 0) {
+      EXPECT_EQ(X.col(1), Xn.col(1));
+      continue;  // the fixed node takes up the momentum: no centre of mass to keep
+    }
+    Vec3 dc = Vec3::Zero();
+    double dc_scale = 0;
+    for (int i = 0; i < 4; ++i)
+      if (w[i] > 0) {
+        dc += (X.col(i) - Xn.col(i)) / w[i];
+        dc_scale += (X.col(i) - Xn.col(i)).norm() / w[i];
+      }
+    EXPECT_LT(dc.norm(), 1e-14 * dc_scale);
+  }
+}
+
+TEST(DcrProject, AllNodesFixedCannotBeResolved) {
+  PairPoints X = points(Vec3(0.2, 0.2, -0.1), kA, kB, kC);
+  const PairPoints X0 = X;
+  EXPECT_FALSE(dcr_project(VF, -1.0, X, PairWeights::Zero(), 1e-6));
+  EXPECT_EQ(X, X0);
+}
+
+// --- impulses --------------------------------------------------------------------------
+
+namespace {
+
+// A random pair with random masses and velocities that approach (v_n < 0).
+struct ImpactCase {
+  DcrPairKind kind;
+  double s;
+  PairPoints X, V;
+  PairWeights w;
+};
+
+ImpactCase random_impact(std::mt19937_64& rng, int trial) {
+  ImpactCase c{trial % 2 ? EE : VF, trial % 2 ? (trial % 4 == 1 ? 1.0 : -1.0) : -1.0, random_points(rng, 3.0),
+               random_points(rng, 2.0), random_inv_mass(rng)};
+  if ((c.s * pair_volume_gradient(c.X).array() * c.V.array()).sum() > 0) c.V = -c.V;
+  return c;
+}
+
+}  // namespace
+
+TEST(DcrImpulse, ConservesMomentaAndElasticEnergy) {
+  std::mt19937_64 rng(31);
+  double worst_p = 0, worst_L = 0, worst_K = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    ImpactCase c = random_impact(rng, trial);
+    const Ledger before = ledger(c.X, c.V, c.w);
+    const DcrImpulse imp = dcr_impulse(c.kind, c.s, c.X, c.V, c.w, {1.0, 0.0, 1e-6});
+    const Ledger after = ledger(c.X, c.V, c.w);
+    EXPECT_GT(imp.normal, 0);
+    EXPECT_EQ(imp.dissipated, 0.0);
+    worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
+    worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
+    worst_K = std::max(worst_K, std::abs(after.kinetic - before.kinetic) / before.kinetic);
+  }
+  EXPECT_LT(worst_p, 1e-13);
+  EXPECT_LT(worst_L, 1e-13);
+  EXPECT_LT(worst_K, 1e-13);
+  RecordProperty("worst_rel_linear_momentum", std::to_string(worst_p));
+  RecordProperty("worst_rel_angular_momentum", std::to_string(worst_L));
+  RecordProperty("worst_rel_kinetic_energy", std::to_string(worst_K));
+}
+
+TEST(DcrImpulse, FrictionAndRestitutionConserveMomentaAndAccountForEnergy) {
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 500; ++trial) {
+    ImpactCase c = random_impact(rng, trial);
+    const DcrLaw law{u(rng), 2 * u(rng), 1e-6};
+    const Ledger before = ledger(c.X, c.V, c.w);
+    const DcrImpulse imp = dcr_impulse(c.kind, c.s, c.X, c.V, c.w, law);
+    const Ledger after = ledger(c.X, c.V, c.w);
+    EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
+    EXPECT_LT((after.L - before.L).norm(), 1e-13 * before.L_scale);
+    EXPECT_GE(imp.dissipated, 0.0);
+    EXPECT_CLOSE(before.kinetic - after.kinetic, imp.dissipated, 0, 1e-13 * before.kinetic);
+    EXPECT_LE(imp.friction, law.friction * imp.normal * (1 + 1e-14));
+  }
+}
+
+TEST(DcrImpulse, PlasticImpactLeavesNoNormalRelativeVelocity) {
+  std::mt19937_64 rng(33);
+  for (int trial = 0; trial < 200; ++trial) {
+    ImpactCase c = random_impact(rng, trial);
+    const PairPoints G = c.s * pair_volume_gradient(c.X);
+    const double gv_before = (G.array() * c.V.array()).sum();
+    dcr_impulse(c.kind, c.s, c.X, c.V, c.w, {0.0, trial % 3 ? 0.5 : 0.0, 1e-6});
+    const double gv_after = (G.array() * c.V.array()).sum();
+    EXPECT_LT(std::abs(gv_after), 1e-13 * (G.norm() * c.V.norm() + std::abs(gv_before)));
+  }
+}
+
+TEST(DcrImpulse, SeparatingPairIsLeftAlone) {
+  PairPoints V = points(Vec3(0, 0, 1), Vec3::Zero(), Vec3::Zero(), Vec3::Zero());
+  const PairPoints V0 = V;
+  const DcrImpulse imp =
+      dcr_impulse(VF, -1.0, points(Vec3(0.2, 0.2, 0), kA, kB, kC), V, PairWeights::Ones(), {1.0, 0.5, 1e-6});
+  EXPECT_EQ(V, V0);
+  EXPECT_EQ(imp.normal, 0.0);
+}
+
+namespace {
+
+// A vertex on the face, sliding along +x at speed vt and approaching at speed vn; the
+// triangle at rest; masses m_vertex and 1 per triangle node.
+struct Slide {
+  PairPoints X = points(Vec3(0.25, 0.3, 0), kA, kB, kC);
+  PairPoints V;
+  PairWeights w;
+  Slide(double vt, double vn, double m_vertex) {
+    V = points(Vec3(vt, 0, -vn), Vec3::Zero(), Vec3::Zero(), Vec3::Zero());
+    w = PairWeights(1 / m_vertex, 1, 1, 1);
+  }
+  Vec3 contact_relative_velocity() const {
+    const double lb = 0.25, lc = 0.3;
+    return V.col(0) - ((1 - lb - lc) * V.col(1) + lb * V.col(2) + lc * V.col(3));
+  }
+};
+
+}  // namespace
+
+TEST(DcrFriction, SticksBelowTheCoulombLimit) {
+  Slide s(0.1, 1.0, 2.0);  // small slide, strong impact: mu = 0.5 can stop it
+  const Ledger before = ledger(s.X, s.V, s.w);
+  const DcrImpulse imp = dcr_impulse(VF, -1.0, s.X, s.V, s.w, {0.0, 0.5, 1e-6});
+  EXPECT_TRUE(imp.stick);
+  EXPECT_LT(imp.friction, 0.5 * imp.normal);
+  const Vec3 vr = s.contact_relative_velocity();
+  EXPECT_LT(vr.head<2>().norm(), 1e-14);  // no tangential relative velocity left
+  EXPECT_LT(std::abs(vr.z()), 1e-14);     // e = 0: no normal one either
+  const Ledger after = ledger(s.X, s.V, s.w);
+  EXPECT_LT((after.p - before.p).norm(), 1e-15 * before.p_scale);
+  EXPECT_LT((after.L - before.L).norm(), 1e-15 * before.L_scale);
+}
+
+TEST(DcrFriction, SlidesWithImpulseMuTimesNormalAboveTheLimit) {
+  const double mu = 0.2, m = 2.0;
+  Slide frictionless(3.0, 1.0, m), rough(3.0, 1.0, m);
+  dcr_impulse(VF, -1.0, frictionless.X, frictionless.V, frictionless.w, {0.5, 0.0, 1e-6});
+  const DcrImpulse imp = dcr_impulse(VF, -1.0, rough.X, rough.V, rough.w, {0.5, mu, 1e-6});
+  EXPECT_FALSE(imp.stick);
+  EXPECT_CLOSE(imp.friction, mu * imp.normal, 1e-14, 0);
+  // Measured on the vertex: the normal impulse from the frictionless run, the slide
+  // impulse as the difference of the two runs.
+  const Vec3 J_n = m * (frictionless.V.col(0) - Vec3(3.0, 0, -1.0));
+  const Vec3 J_t = m * (rough.V.col(0) - frictionless.V.col(0));
+  EXPECT_CLOSE(J_n.norm(), imp.normal, 1e-14, 0);
+  EXPECT_CLOSE(J_n.z(), J_n.norm(), 1e-15, 0);  // the normal impulse is normal
+  EXPECT_CLOSE(J_t.norm(), mu * J_n.norm(), 1e-13, 0);
+  EXPECT_CLOSE(J_t.x(), -J_t.norm(), 1e-13, 0);  // opposite to the sliding direction
+  // Still sliding the same way, slower.
+  const Vec3 vr = rough.contact_relative_velocity();
+  EXPECT_GT(vr.x(), 0);
+  EXPECT_LT(vr.x(), frictionless.contact_relative_velocity().x());
+}
+
+TEST(DcrFriction, EdgeEdgeSlideOppositeToRelativeMotion) {
+  // Edge a along x on top of edge b along y, a slides along +y while approaching.
+  PairPoints X = points(Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0));
+  PairPoints V = points(Vec3(0, 2, -1), Vec3(0, 2, -1), Vec3::Zero(), Vec3::Zero());
+  const double s = 1.0;  // edge a above edge b at height h: V = 4 h / 6 > 0
+  const PairWeights w = PairWeights::Ones();
+  const Ledger before = ledger(X, V, w);
+  const DcrImpulse imp = dcr_impulse(EE, s, X, V, w, {1.0, 0.1, 1e-6});
+  const Ledger after = ledger(X, V, w);
+  EXPECT_GT(imp.normal, 0);
+  EXPECT_CLOSE(imp.friction, 0.1 * imp.normal, 1e-14, 0);
+  const Vec3 dp_a = V.col(0) + V.col(1) - Vec3(0, 4, -2);
+  EXPECT_LT(dp_a.y(), 0);                        // friction opposes the slide
+  EXPECT_GT(dp_a.z(), 0);                        // normal impulse pushes a back up
+  EXPECT_LT((after.p - before.p).norm(), 1e-15 * before.p_scale);
+  EXPECT_LT((after.L - before.L).norm(), 1e-15 * before.L_scale);
+}
+
+TEST(DcrResolvePair, FixedNodesNeverMove) {
+  const PairPoints Xo = points(Vec3(0.2, 0.3, 0.2), kA, kB, kC);
+  PairPoints X = points(Vec3(0.3, 0.3, -0.1), kA, kB, kC);
+  PairPoints V = points(Vec3(0.1, 0, -3), Vec3::Zero(), Vec3::Zero(), Vec3::Zero());
+  const PairWeights w(1.0, 0, 0, 0);
+  const DcrPairResponse r = dcr_resolve_pair(VF, Xo, X, V, w, {0.5, 0.3, 1e-6});
+  EXPECT_TRUE(r.active);
+  EXPECT_TRUE(r.separated);
+  for (int i = 1; i < 4; ++i) {
+    EXPECT_EQ(X.col(i), Xo.col(i));
+    EXPECT_EQ(V.col(i), Vec3::Zero());
+  }
+  EXPECT_CLOSE(X(2, 0), 1e-6 * std::sqrt(2.0), 1e-9, 0);   // lifted to the gap
+  EXPECT_CLOSE(V(2, 0), 1.5, 1e-14, 0);                     // e = 0.5 bounce
+  EXPECT_CLOSE(V(0, 0), 0.0, 0, 1e-15);                     // 0.1 slide stopped by 0.3 x 4.5
+}
+
+TEST(DcrResolvePair, RandomMultiPairImpactsConserveMomenta) {
+  // Impulses on overlapping random pairs of 8 nodes, applied in sequence.
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> pick(0, 7);
+  for (const double e : {1.0, 0.3}) {
+    std::array<Vec3, 8> x, v;
+    std::array<double, 8> w;
+    for (int i = 0; i < 8; ++i) {
+      x[i] = 3 * Vec3(u(rng), u(rng), u(rng));
+      v[i] = Vec3(u(rng), u(rng), u(rng));
+      w[i] = 1 / (1.5 + u(rng));
+    }
+    auto total = [&] {
+      Ledger l;
+      for (int i = 0; i < 8; ++i) {
+        l.p += v[i] / w[i];
+        l.L += x[i].cross(v[i]) / w[i];
+        l.kinetic += 0.5 * v[i].squaredNorm() / w[i];
+        l.p_scale += v[i].norm() / w[i];
+        l.L_scale += x[i].norm() * v[i].norm() / w[i];
+      }
+      return l;
+    };
+    const Ledger before = total();
+    double dissipated = 0;
+    for (int k = 0; k < 200; ++k) {
+      std::array<int, 4> n;
+      for (int i = 0; i < 4; ++i) {
+        bool fresh;
+        do {
+          n[i] = pick(rng);
+          fresh = true;
+          for (int j = 0; j < i; ++j) fresh = fresh && n[j] != n[i];
+        } while (!fresh);
+      }
+      PairPoints X, V;
+      PairWeights wp;
+      for (int i = 0; i < 4; ++i) X.col(i) = x[n[i]], V.col(i) = v[n[i]], wp[i] = w[n[i]];
+      dissipated += dcr_impulse(k % 2 ? EE : VF, -1.0, X, V, wp, {e, 0.0, 1e-6}).dissipated;
+      for (int i = 0; i < 4; ++i) v[n[i]] = V.col(i);
+    }
+    const Ledger after = total();
+    EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
+    EXPECT_LT((after.L - before.L).norm(), 1e-13 * before.L_scale);
+    EXPECT_CLOSE(before.kinetic - after.kinetic, dissipated, 0, 1e-13 * before.kinetic);
+  }
+}
