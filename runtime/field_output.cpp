@@ -1,0 +1,362 @@
+#include "runtime/field_output.hpp"
+
+#include <hdf5.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
+
+/// Owns one HDF5 identifier and closes it with the matching H5?close.
+class H5Id {
+ public:
+  H5Id() = default;
+  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5Id(H5Id&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = H5I_INVALID_HID; }
+  H5Id& operator=(H5Id&& o) noexcept {
+    reset();
+    id_ = o.id_;
+    close_ = o.close_;
+    o.id_ = H5I_INVALID_HID;
+    return *this;
+  }
+  ~H5Id() { reset(); }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  void reset() {
+    if (id_ >= 0) close_(id_);
+    id_ = H5I_INVALID_HID;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+/// Wraps a freshly created identifier; throws naming `what` when HDF5 failed.
+H5Id checked(hid_t id, herr_t (*close)(hid_t), const std::string& what) {
+  SHATTER_REQUIRE(id >= 0, "fields output: HDF5 failed to " << what);
+  return H5Id(id, close);
+}
+
+void check(herr_t status, const std::string& what) {
+  SHATTER_REQUIRE(status >= 0, "fields output: HDF5 failed to " << what);
+}
+
+/// Row placement of one rank's part of a global array.
+struct Rows {
+  hsize_t local = 0;   ///< rows this rank writes
+  hsize_t offset = 0;  ///< first global row of this rank
+  hsize_t total = 0;   ///< rows of all ranks
+};
+
+/// Creates dataset `name` in `group` with `rows.total` x `cols` entries
+/// (1-D when cols == 0) and writes this rank's rows collectively.
+void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, const void* data,
+                const Rows& rows, hsize_t cols) {
+  const int rank = cols == 0 ? 1 : 2;
+  const std::array<hsize_t, 2> dims{rows.total, cols};
+  const std::array<hsize_t, 2> local{rows.local, cols};
+  const std::array<hsize_t, 2> start{rows.offset, 0};
+  H5Id file_space = checked(H5Screate_simple(rank, dims.data(), nullptr), H5Sclose,
+                            std::string("create the dataspace of ") + name);
+  H5Id dset = checked(H5Dcreate2(group, name, file_type, file_space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                                 H5P_DEFAULT),
+                      H5Dclose, std::string("create dataset ") + name);
+  H5Id mem_space = checked(H5Screate_simple(rank, local.data(), nullptr), H5Sclose,
+                           std::string("create the memory space of ") + name);
+  if (rows.local == 0) {
+    // A rank without rows still joins the collective transfer.
+    check(H5Sselect_none(file_space.get()), "select nothing");
+    check(H5Sselect_none(mem_space.get()), "select nothing");
+  } else {
+    check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, local.data(),
+                              nullptr),
+          std::string("select the rows of ") + name);
+  }
+  H5Id xfer = checked(H5Pcreate(H5P_DATASET_XFER), H5Pclose, "create a transfer list");
+  check(H5Pset_dxpl_mpio(xfer.get(), H5FD_MPIO_COLLECTIVE), "request collective transfer");
+  static const double no_data = 0.0;
+  check(H5Dwrite(dset.get(), mem_type, mem_space.get(), file_space.get(), xfer.get(),
+                 data ? data : &no_data),
+        std::string("write dataset ") + name);
+}
+
+/// Writes a scalar attribute (collective: every rank passes the same value).
+void write_attribute(hid_t object, const char* name, hid_t type, const void* value) {
+  H5Id space = checked(H5Screate(H5S_SCALAR), H5Sclose, "create a scalar space");
+  H5Id attr = checked(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                      H5Aclose, std::string("create attribute ") + name);
+  check(H5Awrite(attr.get(), type, value), std::string("write attribute ") + name);
+}
+
+/// What fields.xdmf needs to know about one written frame.
+struct FrameRecord {
+  int step;
+  double time;
+  int mesh;  ///< k of /mesh/<k>
+  int order;
+  long long nodes;
+  long long elements;
+  bool fragment;
+  bool damage;
+};
+
+std::string step_group_name(int step) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/step_%06d", step);
+  return name;
+}
+
+/// One <DataItem> naming an HDF5 dataset of fields.h5.
+void data_item(std::ostream& os, const std::string& dims, const char* number_type, int precision,
+               const std::string& dataset) {
+  os << "          <DataItem Dimensions=\"" << dims << "\" NumberType=\"" << number_type
+     << "\" Precision=\"" << precision << "\" Format=\"HDF\">fields.h5:" << dataset
+     << "</DataItem>\n";
+}
+
+void attribute(std::ostream& os, const char* name, const char* type, const char* center,
+               const std::string& dims, const char* number_type, int precision,
+               const std::string& dataset) {
+  os << "        <Attribute Name=\"" << name << "\" AttributeType=\"" << type << "\" Center=\""
+     << center << "\">\n";
+  data_item(os, dims, number_type, precision, dataset);
+  os << "        </Attribute>\n";
+}
+
+/// The XDMF 3 index of all frames: a temporal collection of uniform grids.
+std::string xdmf_text(const std::vector<FrameRecord>& frames) {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  os << "<?xml version=\"1.0\" ?>\n"
+     << "<Xdmf Version=\"3.0\">\n"
+     << "  <Domain>\n"
+     << "    <Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const FrameRecord& f : frames) {
+    const std::string mesh = "/mesh/" + std::to_string(f.mesh);
+    const std::string step = step_group_name(f.step);
+    const std::string n = std::to_string(f.nodes), e = std::to_string(f.elements);
+    const int k = f.order == 1 ? 4 : 10;
+    os << "      <Grid Name=\"" << step.substr(1) << "\" GridType=\"Uniform\">\n"
+       << "        <Time Value=\"" << f.time << "\"/>\n"
+       << "        <Topology TopologyType=\"" << (f.order == 1 ? "Tetrahedron" : "Tetrahedron_10")
+       << "\" NumberOfElements=\"" << e << "\">\n";
+    data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
+    os << "        </Topology>\n"
+       << "        <Geometry GeometryType=\"XYZ\">\n";
+    data_item(os, n + " 3", "Float", 8, mesh + "/coordinates");
+    os << "        </Geometry>\n";
+    attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/displacement");
+    attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/velocity");
+    attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
+    attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
+    attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
+    if (f.fragment) attribute(os, "fragment", "Scalar", "Cell", e, "Int", 4, step + "/fragment");
+    if (f.damage) attribute(os, "damage", "Scalar", "Cell", e, "Float", 8, step + "/damage");
+    os << "      </Grid>\n";
+  }
+  os << "    </Grid>\n"
+     << "  </Domain>\n"
+     << "</Xdmf>\n";
+  return os.str();
+}
+
+/// Writes `text` to `path` through a temporary file and a rename, so a reader
+/// never sees a half-written index. Returns false on failure.
+bool replace_file(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    if (!out.flush()) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
+
+/// True on every rank when `ok` holds on every rank of `comm`.
+bool all_ok(bool ok, MPI_Comm comm) {
+  int local = ok ? 1 : 0, global = 0;
+  MPI_Allreduce(&local, &global, 1, MPI_INT, MPI_MIN, comm);
+  return global == 1;
+}
+
+/// Throws on every rank when some rank failed: the failing rank with its own
+/// message, the others with a pointer to it (STYLE.md "Errors").
+void require_all(const std::string& local_error, MPI_Comm comm) {
+  if (all_ok(local_error.empty(), comm)) return;
+  if (!local_error.empty()) throw Error(local_error);
+  throw Error("fields output: another rank failed (see its message)");
+}
+
+}  // namespace
+
+struct FieldWriter::State {
+  MPI_Comm comm;
+  int rank = 0;
+  std::filesystem::path xdmf_path;
+  H5Id file;
+  int mesh_count = 0;  ///< mesh groups written so far
+  std::uint64_t mesh_revision = 0;
+  int mesh_order = 0;
+  long long mesh_nodes = -1, mesh_elements = -1;
+  std::vector<FrameRecord> frames;
+
+  void write_xdmf() {
+    std::string error;
+    if (rank == 0 && !replace_file(xdmf_path, xdmf_text(frames)))
+      error = "fields output: cannot write " + xdmf_path.string();
+    require_all(error, comm);
+  }
+};
+
+FieldWriter::FieldWriter(const std::filesystem::path& dir, MPI_Comm comm)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.comm = comm;
+  MPI_Comm_rank(comm, &s.rank);
+  s.xdmf_path = dir / "fields.xdmf";
+  const std::filesystem::path h5_path = dir / "fields.h5";
+
+  std::string error;
+  if (s.rank == 0) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) error = "fields output: cannot create directory " + dir.string() + ": " + ec.message();
+  }
+  require_all(error, comm);
+
+  H5Id fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create a file access list");
+  check(H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL), "select the MPI-IO driver");
+  check(H5Pset_coll_metadata_write(fapl.get(), true), "request collective metadata writes");
+  s.file = H5Id(H5Fcreate(h5_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
+  if (!all_ok(s.file.valid(), comm))
+    throw Error("fields output: cannot create HDF5 file " + h5_path.string());
+  checked(H5Gcreate2(s.file.get(), "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+          "create group /mesh");
+  // An index without frames replaces any stale one from an earlier run.
+  s.write_xdmf();
+}
+
+FieldWriter::~FieldWriter() = default;
+
+void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
+  State& s = *state_;
+  const size_t n = static_cast<size_t>(mesh.num_nodes());
+  const size_t e = static_cast<size_t>(mesh.num_elements());
+  const size_t k = static_cast<size_t>(mesh.nodes_per_element());
+
+  // Optional fields are written when any rank has them; then every rank
+  // passes them (a rank without elements passes empty spans).
+  const std::array<int, 2> has_local{!frame.fragment.empty(), !frame.damage.empty()};
+  std::array<int, 2> has{0, 0};
+  MPI_Allreduce(has_local.data(), has.data(), 2, MPI_INT, MPI_MAX, s.comm);
+
+  std::ostringstream error;
+  auto expect_size = [&](const char* name, size_t size, size_t want) {
+    if (size != want && error.str().empty())
+      error << "fields output, step " << frame.step << ": " << name << " has " << size
+            << " entries, expected " << want;
+  };
+  expect_size("mesh.conn", mesh.conn.size(), e * k);
+  expect_size("displacement", frame.displacement.size(), n);
+  expect_size("velocity", frame.velocity.size(), n);
+  expect_size("stress", frame.stress.size(), 6 * e);
+  expect_size("von_mises", frame.von_mises.size(), e);
+  expect_size("body", frame.body.size(), e);
+  if (has[0]) expect_size("fragment", frame.fragment.size(), e);
+  if (has[1]) expect_size("damage", frame.damage.size(), e);
+  require_all(error.str(), s.comm);
+
+  // Global placement: [0] nodes, [1] elements.
+  const std::array<long long, 2> local{static_cast<long long>(n), static_cast<long long>(e)};
+  std::array<long long, 2> offset{0, 0}, total{0, 0};
+  MPI_Exscan(local.data(), offset.data(), 2, MPI_LONG_LONG, MPI_SUM, s.comm);
+  if (s.rank == 0) offset = {0, 0};
+  MPI_Allreduce(local.data(), total.data(), 2, MPI_LONG_LONG, MPI_SUM, s.comm);
+  const Rows node_rows{static_cast<hsize_t>(n), static_cast<hsize_t>(offset[0]),
+                       static_cast<hsize_t>(total[0])};
+  const Rows elem_rows{static_cast<hsize_t>(e), static_cast<hsize_t>(offset[1]),
+                       static_cast<hsize_t>(total[1])};
+
+  int changed_local = s.mesh_count == 0 || mesh.revision != s.mesh_revision ||
+                      mesh.order != s.mesh_order || total[0] != s.mesh_nodes ||
+                      total[1] != s.mesh_elements;
+  int changed = 0;
+  MPI_Allreduce(&changed_local, &changed, 1, MPI_INT, MPI_MAX, s.comm);
+  if (changed) {
+    const std::string name = "/mesh/" + std::to_string(s.mesh_count);
+    H5Id group = checked(H5Gcreate2(s.file.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT,
+                                    H5P_DEFAULT),
+                         H5Gclose, "create group " + name);
+    write_rows(group.get(), "coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE,
+               mesh.reference.data(), node_rows, 3);
+    // Gmsh numbers the TET10 mid-edge nodes 8:(2,3) 9:(1,3); XDMF/VTK 8:(1,3) 9:(2,3).
+    std::vector<std::int64_t> topology(mesh.conn.begin(), mesh.conn.end());
+    if (mesh.order == 2)
+      for (size_t i = 0; i < e; ++i) std::swap(topology[i * k + 8], topology[i * k + 9]);
+    write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(),
+               elem_rows, k);
+    s.mesh_revision = mesh.revision;
+    s.mesh_order = mesh.order;
+    s.mesh_nodes = total[0];
+    s.mesh_elements = total[1];
+    ++s.mesh_count;
+  }
+
+  const std::string name = step_group_name(frame.step);
+  SHATTER_REQUIRE(H5Lexists(s.file.get(), name.c_str(), H5P_DEFAULT) == 0,
+                  "fields output: step " << frame.step << " was already written to "
+                                         << s.xdmf_path.parent_path() / "fields.h5");
+  H5Id group = checked(H5Gcreate2(s.file.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT,
+                                  H5P_DEFAULT),
+                       H5Gclose, "create group " + name);
+  const int mesh_index = s.mesh_count - 1;
+  write_attribute(group.get(), "time", H5T_NATIVE_DOUBLE, &frame.time);
+  write_attribute(group.get(), "step", H5T_NATIVE_INT, &frame.step);
+  write_attribute(group.get(), "mesh", H5T_NATIVE_INT, &mesh_index);
+
+  write_rows(group.get(), "displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE,
+             frame.displacement.data(), node_rows, 3);
+  write_rows(group.get(), "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.velocity.data(),
+             node_rows, 3);
+  // Voigt xx yy zz yz xz xy -> XDMF Tensor6 xx xy xz yy yz zz.
+  constexpr std::array<int, 6> tensor6_from_voigt{0, 5, 4, 1, 3, 2};
+  std::vector<double> stress(6 * e);
+  for (size_t i = 0; i < e; ++i)
+    for (int c = 0; c < 6; ++c) stress[6 * i + c] = frame.stress[6 * i + tensor6_from_voigt[c]];
+  write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
+  write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(),
+             elem_rows, 0);
+  write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);
+  if (has[0])
+    write_rows(group.get(), "fragment", H5T_NATIVE_INT, H5T_STD_I32LE, frame.fragment.data(),
+               elem_rows, 0);
+  if (has[1])
+    write_rows(group.get(), "damage", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.damage.data(),
+               elem_rows, 0);
+  group.reset();
+  // The index may be opened while the run goes on: make the data it names durable first.
+  check(H5Fflush(s.file.get(), H5F_SCOPE_GLOBAL), "flush fields.h5");
+
+  s.frames.push_back(FrameRecord{frame.step, frame.time, mesh_index, s.mesh_order, total[0],
+                                 total[1], has[0] != 0, has[1] != 0});
+  s.write_xdmf();
+}
+
+}  // namespace shatter

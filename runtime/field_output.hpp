@@ -1,0 +1,86 @@
+#pragma once
+// Field output for ParaView (DESIGN.md "Inputs and outputs", SCENE.md
+// "Outputs"): DIR/fields.h5, written collectively by every rank through
+// parallel HDF5 (MPI-IO), indexed by DIR/fields.xdmf (XDMF 3).
+//
+// Layout of fields.h5 (n = nodes, e = elements, summed over ranks):
+//   /mesh/<k>/coordinates   n x 3 float64   reference coordinates X, m
+//   /mesh/<k>/topology      e x 4 or e x 10 int64, node rows of /mesh/<k>
+//                           (TET10 in XDMF/VTK order: mid-edge nodes on edges
+//                           4:(0,1) 5:(1,2) 6:(0,2) 7:(0,3) 8:(1,3) 9:(2,3))
+//   /step_<NNNNNN>/         one group per frame, attributes time (float64, s),
+//                           step (int32) and mesh (int32, the k it refers to)
+//       displacement        n x 3 float64, m
+//       velocity            n x 3 float64, m/s
+//       stress              e x 6 float64, Cauchy stress in XDMF Tensor6 order
+//                           xx xy xz yy yz zz, Pa
+//       von_mises           e float64, Pa
+//       body                e int32
+//       fragment            e int32 (only when fracture is on)
+//       damage              e float64 (only when given)
+// A mesh group k = 0, 1, ... is written for the first frame and again for
+// every frame whose mesh topology changed (fracture splits nodes).
+#include <mpi.h>
+
+#include <filesystem>
+#include <memory>
+#include <span>
+
+#include "kernels/types.hpp"
+#include "mesh/mesh.hpp"
+
+namespace shatter {
+
+/// Fields of one output frame for the items this rank writes (all of them on
+/// 1 rank). Row i of a per-node array belongs to node i of the Mesh passed
+/// with it, row e of a per-element array to its element e.
+struct FieldFrame {
+  int step = 0;       ///< time step number; names the group /step_<NNNNNN>
+  double time = 0.0;  ///< s
+  std::span<const Vec3> displacement;  ///< [n] per node, x - X, m
+  std::span<const Vec3> velocity;      ///< [n] per node, m/s
+  /// [e*6 + c] per element, Cauchy stress in Voigt order c = xx yy zz yz xz xy, Pa.
+  std::span<const double> stress;
+  std::span<const double> von_mises;  ///< [e] per element, Pa
+  std::span<const int> body;          ///< [e] per element, body index
+  /// [e] per element, fragment id; empty when fracture is off (then not written).
+  std::span<const int> fragment;
+  /// [e] per element, damage in [0, 1]; optional (empty = not written).
+  std::span<const double> damage;
+};
+
+/// Writes fields.h5 and its XDMF index fields.xdmf into one directory.
+///
+/// Every rank of `comm` calls the constructor, write() and the destructor
+/// collectively. Each rank writes the rows of the nodes and elements it owns,
+/// placed after the rows of the lower ranks (offsets from MPI_Exscan of the
+/// counts), with collective MPI-IO transfers. Assumption: the Mesh a rank
+/// passes holds exactly its output rows, and its connectivity `conn` is
+/// already in output numbering, i.e. indexes the rows of all ranks in rank
+/// order (on one rank: the local ids). Only rank 0 writes fields.xdmf.
+class FieldWriter {
+ public:
+  /// Creates `dir` if needed and `dir`/fields.h5 (truncating it) with
+  /// H5Pset_fapl_mpio on `comm`, and an fields.xdmf without frames.
+  /// Throws shatter::Error naming the path when either cannot be created.
+  FieldWriter(const std::filesystem::path& dir, MPI_Comm comm);
+  /// Closes fields.h5 (collective).
+  ~FieldWriter();
+  FieldWriter(const FieldWriter&) = delete;
+  FieldWriter& operator=(const FieldWriter&) = delete;
+
+  /// Writes one frame (collective). The mesh geometry and topology (reference
+  /// coordinates + connectivity) are written for the first frame and again
+  /// only when mesh.revision, the order or the global counts change (fracture
+  /// splits nodes). fields.xdmf is rewritten (atomically) after every frame,
+  /// so it always describes the frames written so far.
+  /// Throws shatter::Error when a span's size does not match the mesh, the
+  /// step was already written, or HDF5 fails.
+  void write(const Mesh& mesh, const FieldFrame& frame);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace shatter
