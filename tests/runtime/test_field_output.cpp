@@ -5,6 +5,7 @@
 #include <hdf5.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -376,11 +377,13 @@ std::vector<unsigned char> raw_bytes(hid_t file, const std::string& name) {
   return out;
 }
 
-/// The run of the MPI test: 2 frames on `mesh`, 1 after a node split, each
-/// rank writing the contiguous rows [begin(r), begin(r+1)) of every array.
+/// The run of the MPI test: 2 frames on a chain mesh, 1 after a node split,
+/// each rank writing the contiguous rows [begin(r), begin(r+1)) of every
+/// array. From 3 ranks on, the last rank has no rows at all.
 void write_run(const fs::path& dir, MPI_Comm comm) {
   const int rank = comm_rank(comm), size = comm_size(comm);
-  const auto begin = [&](int total, int r) { return total * r / size; };
+  const int parts = size >= 3 ? size - 1 : size;
+  const auto begin = [&](int total, int r) { return total * std::min(r, parts) / parts; };
   Mesh whole = chain_mesh(7);
   Mesh split = chain_mesh(7);
   split.revision = 1;
