@@ -1,0 +1,147 @@
+#include "fracture/cohesive_elements.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+
+namespace {
+
+constexpr int kSlots = 6;  // node slots per side, enough for a TET10 facet
+
+/// Facet shape functions at barycentrics L (corners a, b, c; then for the
+/// 6-node facet the mid-edge nodes of (a,b), (b,c), (c,a)).
+std::array<double, 6> facet_shape(const Vec3& L, int k) {
+  if (k == 3) return {L[0], L[1], L[2], 0, 0, 0};
+  return {L[0] * (2 * L[0] - 1), L[1] * (2 * L[1] - 1), L[2] * (2 * L[2] - 1),
+          4 * L[0] * L[1],       4 * L[1] * L[2],       4 * L[2] * L[0]};
+}
+
+const std::array<Vec3, kCohesivePoints>& facet_points() {
+  static const std::array<Vec3, kCohesivePoints> p = {Vec3(2.0 / 3, 1.0 / 6, 1.0 / 6),
+                                                      Vec3(1.0 / 6, 2.0 / 3, 1.0 / 6),
+                                                      Vec3(1.0 / 6, 1.0 / 6, 2.0 / 3)};
+  return p;
+}
+
+void refresh_side_nodes(const Mesh& mesh, const Topology& topo, CohesiveElements& coh, Index first) {
+  const int k = mesh.order == 1 ? 3 : 6;
+  coh.side_nodes.resize(static_cast<size_t>(coh.size()) * 2 * kSlots, -1);
+  for (Index c = first; c < coh.size(); ++c)
+    for (int s = 0; s < 2; ++s) {
+      const Index* conn = mesh.element(topo.facet_elem[coh.facet[c]][s]);
+      const size_t slot = (static_cast<size_t>(c) * 2 + s) * kSlots;
+      for (int j = 0; j < k; ++j) coh.side_nodes[slot + j] = conn[coh.side_local[slot + j]];
+    }
+}
+
+}  // namespace
+
+Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& coh,
+                                   std::span<const Index> facets) {
+  const int k = mesh.order == 1 ? 3 : 6;
+  std::vector<Index> sorted(facets.begin(), facets.end());
+  std::sort(sorted.begin(), sorted.end(), [&](Index a, Index b) { return topo.facet_gid[a] < topo.facet_gid[b]; });
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+
+  Insertion out;
+  out.first_cohesive = coh.size();
+  for (const Index f : sorted) {
+    SHATTER_REQUIRE(topo.facet_state[f] == FacetState::intact && topo.is_interior(f),
+                    "insert_cohesive_elements: facet " << topo.facet_gid[f] << " is not an intact interior facet");
+    topo.facet_state[f] = FacetState::cohesive;
+    const auto [e0, e1] = topo.facet_elem[f];
+    const int face0 = topo.facet_face[f][0];
+    const Index* c0 = mesh.element(e0);
+    const Index* c1 = mesh.element(e1);
+    // The facet is intact, so both sides still share its nodes: match them by id.
+    std::array<std::int8_t, 2 * kSlots> local;
+    local.fill(-1);
+    for (int j = 0; j < k; ++j) {
+      local[j] = static_cast<std::int8_t>(kTetFaces[face0][j]);
+      const Index n = c0[local[j]];
+      for (int a = 0; a < mesh.nodes_per_element(); ++a)
+        if (c1[a] == n) local[kSlots + j] = static_cast<std::int8_t>(a);
+      SHATTER_ASSERT(local[kSlots + j] >= 0);
+    }
+    const Vec3& X0 = mesh.reference[c0[local[0]]];
+    const Vec3 area_vector = 0.5 * (mesh.reference[c0[local[1]]] - X0).cross(mesh.reference[c0[local[2]]] - X0);
+    coh.facet.push_back(f);
+    coh.side_local.insert(coh.side_local.end(), local.begin(), local.end());
+    coh.area.push_back(area_vector.norm());
+    coh.normal.push_back(area_vector.normalized());
+    coh.delta_max.insert(coh.delta_max.end(), kCohesivePoints, 0.0);
+    out.crack_faces.push_back({e0, face0});
+    out.crack_faces.push_back({e1, topo.facet_face[f][1]});
+  }
+  out.new_nodes = split_nodes(mesh, topo, sorted);
+  // Splits renumber nodes of older cohesive elements too.
+  refresh_side_nodes(mesh, topo, coh, out.new_nodes.empty() ? out.first_cohesive : 0);
+  return out;
+}
+
+CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& coh, FractureLaws laws,
+                               std::span<const Vec3> x, std::span<Vec3> f_int) {
+  const int k = mesh.order == 1 ? 3 : 6;
+  const Index nc = coh.size();
+  std::vector<Vec3> local_force(static_cast<size_t>(nc) * 2 * kSlots, Vec3::Zero());
+  std::vector<CohesiveEnergy> local_energy(nc);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nc, 256), [&](const tbb::blocked_range<Index>& r) {
+    for (Index c = r.begin(); c != r.end(); ++c) {
+      const CohesiveLaw& law = *facet_law(mesh, topo, laws, coh.facet[c]);
+      const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+      const Index* side1 = side0 + kSlots;
+      // Mid-surface normal from the corners, pointing from side 0 to side 1.
+      std::array<Vec3, 3> mid;
+      for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
+      const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
+      Vec3* f = local_force.data() + static_cast<size_t>(c) * 2 * kSlots;
+      CohesiveEnergy& energy = local_energy[c];
+      for (int q = 0; q < kCohesivePoints; ++q) {
+        const std::array<double, 6> N = facet_shape(facet_points()[q], k);
+        Vec3 opening = Vec3::Zero();
+        for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
+        double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
+        const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
+        delta_max = t.delta_max;
+        const double w = coh.area[c] / kCohesivePoints;
+        for (int j = 0; j < k; ++j) {
+          f[kSlots + j] += (w * N[j]) * t.traction;
+          f[j] -= (w * N[j]) * t.traction;
+        }
+        energy.stored += w * t.stored;
+        energy.dissipated += w * t.dissipated;
+      }
+    }
+  });
+  CohesiveEnergy total;
+  for (Index c = 0; c < nc; ++c) {
+    const size_t base = static_cast<size_t>(c) * 2 * kSlots;
+    for (int s = 0; s < 2; ++s)
+      for (int j = 0; j < k; ++j) f_int[coh.side_nodes[base + s * kSlots + j]] += local_force[base + s * kSlots + j];
+    total.stored += local_energy[c].stored;
+    total.dissipated += local_energy[c].dissipated;
+  }
+  return total;
+}
+
+Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh, FractureLaws laws) {
+  Index freed = 0;
+  for (Index c = 0; c < coh.size(); ++c) {
+    const Index f = coh.facet[c];
+    if (topo.facet_state[f] != FacetState::cohesive) continue;
+    const double delta_c = facet_law(mesh, topo, laws, f)->delta_c;
+    const double* dm = coh.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+    if (std::all_of(dm, dm + kCohesivePoints, [&](double d) { return d >= delta_c; })) {
+      topo.facet_state[f] = FacetState::free;
+      ++freed;
+    }
+  }
+  return freed;
+}
+
+}  // namespace shatter

@@ -1,0 +1,89 @@
+#pragma once
+// Cohesive elements: storage, extrinsic insertion with node splitting, and
+// nodal forces (DESIGN.md step 5).
+#include <array>
+#include <span>
+#include <vector>
+
+#include "fracture/facet_criterion.hpp"
+
+namespace shatter {
+
+/// Quadrature points per cohesive element: the 3-point interior rule on the
+/// facet triangle, barycentrics (2/3, 1/6, 1/6) and permutations, weights 1/3
+/// (exact to degree 2; Strang & Fix).
+inline constexpr int kCohesivePoints = 3;
+
+/// The cohesive elements of a mesh. Layouts (c = cohesive elements,
+/// k = 3 facet nodes for TET4, 6 for TET10, slots of 6 per side):
+///   facet[c]           facet of Topology
+///   side_local[(2c + s) 6 + j]  local node index, in element facet_elem[f][s],
+///                      of facet node j of side s; j runs over side 0's face
+///                      (kTetFaces order, outward of element 0), side 1 is
+///                      matched node by node (same reference position)
+///   side_nodes[(2c + s) 6 + j]  the current node ids of those slots (refreshed
+///                      by every insertion, since later splits renumber nodes)
+///   area[c]            reference area of the facet's corner triangle, m^2
+///   normal[c]          its reference unit normal, from side 0 to side 1
+///   delta_max[c kCohesivePoints + q]  largest effective opening reached, m
+struct CohesiveElements {
+  std::vector<Index> facet;
+  std::vector<std::int8_t> side_local;
+  std::vector<Index> side_nodes;
+  std::vector<double> area;
+  std::vector<Vec3> normal;
+  std::vector<double> delta_max;
+
+  Index size() const { return static_cast<Index>(facet.size()); }
+};
+
+/// What an insertion changed, for the caller to update its own arrays.
+struct Insertion {
+  /// (new node, parent node) in creation order. Before using the new nodes the
+  /// caller resizes its nodal arrays to mesh.num_nodes() and, in this order,
+  /// copies position, velocity (and displacement) from the parent, then
+  /// recomputes the lumped masses of the parent and the copy from their
+  /// element stars (mass of a node = sum of its elements' contributions), so
+  /// that mass and momentum are unchanged.
+  std::vector<std::array<Index, 2>> new_nodes;
+  /// New crack faces: (element, local face) for both sides of every inserted
+  /// facet, oriented outward of the element (nodes: face_nodes(mesh, e, face)).
+  std::vector<std::array<Index, 2>> crack_faces;
+  /// The new cohesive elements are [first_cohesive, cohesive.size()).
+  Index first_cohesive = 0;
+};
+
+/// Insert cohesive elements on the given intact interior facets (extrinsic:
+/// delta_max = 0, traction sigma_c at first opening). The facets are processed
+/// in canonical order (sorted by Topology::facet_gid) whatever their order in
+/// `facets`, so the result does not depend on how they were found. Marks the
+/// facets cohesive, splits the nodes whose star falls apart (split_nodes),
+/// updates `mesh` (conn, reference, node_gid, node_body, node -> element CSR)
+/// and the side node ids of all cohesive elements.
+Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& cohesive,
+                                   std::span<const Index> facets);
+
+/// Energies of the cohesive elements, J.
+struct CohesiveEnergy {
+  double stored = 0;      ///< recoverable (secant and compression penalty)
+  double dissipated = 0;  ///< dissipated up to the current delta_max
+};
+
+/// Cohesive nodal forces at current positions `x` (m): adds the internal force
+/// dE/dx (same sign as the volume elements' internal forces, N) of every
+/// cohesive element to `f_int`, updates delta_max, and returns the energies.
+/// Traction per unit reference area, integrated on the reference facet with
+/// the 3-point rule; the opening is interpolated with the facet's shape
+/// functions (linear, or quadratic on TET10 facets), the normal is that of the
+/// current mid-surface corner triangle (Ortiz & Pandolfi 1999, sec. 3).
+/// Element-local forces are computed with oneTBB and scattered in element
+/// order: bitwise identical for any number of threads.
+CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& cohesive,
+                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int);
+
+/// Mark free the cohesive facets whose every quadrature point has opened past
+/// delta_c (no traction left; the two sides now belong to separate fragments
+/// unless joined elsewhere). Returns the number of facets freed.
+Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive, FractureLaws laws);
+
+}  // namespace shatter

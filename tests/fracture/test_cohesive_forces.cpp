@@ -1,0 +1,150 @@
+// Cohesive element forces: a two-tet bar pulled apart through its one facet,
+// the whole pipeline (criterion -> insertion -> copies -> cohesive forces ->
+// release -> fragments), with the energy dissipated checked against Gc x area.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "expect_close.hpp"
+#include "fracture/cohesive_elements.hpp"
+#include "fracture/fragments.hpp"
+#include "fracture_fixtures.hpp"
+#include "kernels/neo_hookean.hpp"
+#include "kernels/tet4.hpp"
+
+using namespace shatter;
+
+namespace {
+
+/// Two tets sharing the facet (0,1,2) in the plane z = 0 (area 1/2); apex 3
+/// above, apex 4 below.
+Mesh two_tets() {
+  Mesh m;
+  m.order = 1;
+  m.reference = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.3, 1), Vec3(0.3, 0.2, -1)};
+  m.node_gid = {1, 2, 3, 4, 5};
+  m.node_body = {0, 0, 0, 0, 0};
+  m.conn = {0, 1, 2, 3, 0, 2, 1, 4};
+  m.elem_gid = {1, 2};
+  m.elem_body = {0, 0};
+  m.elem_material = {0, 0};
+  m.build_node_elements();
+  return m;
+}
+
+}  // namespace
+
+TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
+  Mesh m = two_tets();
+  ASSERT_NO_THROW(validate_mesh(m, "two tets"));
+  Topology t = build_topology(m);
+  CohesiveElements coh;
+  const NeoHookean mat = NeoHookean::from_young_poisson(1.0e4, 0.25, 1.0);
+  const double gc = 1.0;
+  const CohesiveLaw law = make_cohesive_law(100.0, gc, 0.8, 1.0e7);
+  const auto laws = test::one_law(law);
+
+  std::vector<Vec3> x = m.reference, v(m.num_nodes(), Vec3::Zero());
+  std::vector<double> mass = test::lumped_masses(m, mat.density);
+  const double v_pull = 0.01;  // m/s, each apex: slow against c = 115 m/s
+  const double dt = 1.0e-4, damping = 20.0;  // 1/s, mass-proportional, on the free nodes
+  std::vector<Vec3> f, f_coh;
+  std::vector<double> stress;
+  double work = 0;  // work done on the cohesive element, J
+  bool inserted = false, released = false;
+  CohesiveEnergy energy;
+  auto apex = [&](Index n) { return m.node_gid[n] == 4 || m.node_gid[n] == 5; };
+
+  auto compute_forces = [&]() {
+    f.assign(m.num_nodes(), Vec3::Zero());
+    f_coh.assign(m.num_nodes(), Vec3::Zero());
+    stress.assign(9 * m.num_elements(), 0.0);
+    for (Index e = 0; e < m.num_elements(); ++e) {
+      const Index* c = m.element(e);
+      const Tet4Reference ref = tet4_reference(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]],
+                                               m.reference[c[3]]);
+      const Tet4Force fe = tet4_internal_force(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv, ref.volume, mat);
+      for (int a = 0; a < 4; ++a) f[c[a]] += fe.f.col(a);
+      const Mat3 sigma = mat.cauchy_stress(tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv));
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(stress.data() + 9 * e) = sigma;
+    }
+    energy = cohesive_forces(m, t, coh, laws, x, f_coh);
+    for (Index n = 0; n < m.num_nodes(); ++n) f[n] += f_coh[n];
+  };
+
+  compute_forces();
+  int steps = 0;
+  for (; steps < 400000 && !released; ++steps) {
+    std::vector<Vec3> x_old = x, f_coh_old = f_coh;
+    for (Index n = 0; n < m.num_nodes(); ++n) {
+      if (apex(n))
+        v[n] = Vec3(0, 0, m.node_gid[n] == 4 ? v_pull : -v_pull);
+      else
+        v[n] += 0.5 * dt * (-f[n] / mass[n] - damping * v[n]);
+      x[n] += dt * v[n];
+    }
+    compute_forces();
+    for (Index n = 0; n < m.num_nodes(); ++n) {
+      if (!apex(n)) v[n] += 0.5 * dt * (-f[n] / mass[n] - damping * v[n]);
+      work += 0.5 * (f_coh_old[n] + f_coh[n]).dot(x[n] - x_old[n]);
+    }
+    if (!inserted) {
+      const std::vector<Index> critical = critical_facets(m, t, x, stress, 9, laws);
+      if (!critical.empty()) {
+        ASSERT_EQ(critical.size(), 1u);
+        const Insertion ins = insert_cohesive_elements(m, t, coh, critical);
+        ASSERT_EQ(ins.new_nodes.size(), 3u);  // all three facet nodes split
+        ASSERT_EQ(ins.crack_faces.size(), 2u);
+        x.resize(m.num_nodes());
+        v.resize(m.num_nodes());
+        for (const auto& [copy, parent] : ins.new_nodes) {
+          x[copy] = x[parent];
+          v[copy] = v[parent];
+        }
+        mass = test::lumped_masses(m, mat.density);
+        compute_forces();
+        inserted = true;
+      }
+    } else {
+      released = release_debonded(m, t, coh, laws) == 1;
+    }
+  }
+  ASSERT_TRUE(inserted);
+  ASSERT_TRUE(released) << "after " << steps << " steps";
+  const double area = 0.5, expected = gc * area;
+  EXPECT_CLOSE(energy.dissipated, expected, 1e-12, 0);
+  EXPECT_EQ(energy.stored, 0.0);
+  // The work of the cohesive forces over the history, an independent check of
+  // forces against the law's energy.
+  EXPECT_CLOSE(work, expected, 0.01, 0);
+  const Fragments fr = find_fragments(m, t, x, v, mass);
+  ASSERT_EQ(fr.count(), 2);
+  EXPECT_GT(fr.stats[0].velocity.z(), 0.0);  // element 1 (apex 4, above) moves up
+  EXPECT_LT(fr.stats[1].velocity.z(), 0.0);
+}
+
+TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
+  Mesh m = two_tets();
+  Topology t = build_topology(m);
+  CohesiveElements coh;
+  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 0.6, 1.0e7);
+  const auto laws = test::one_law(law);
+  const std::vector<Index> facet = {t.elem_facet[3]};  // face 3 of element 0 = (0,2,1)
+  insert_cohesive_elements(m, t, coh, facet);
+  ASSERT_EQ(m.num_nodes(), 8);
+  std::vector<Vec3> x = m.reference;
+  // A mixed opening with a rotation of side 1, then a compressed one.
+  for (double sign : {1.0, -1.0}) {
+    for (Index n = 5; n < 8; ++n) x[n] = m.reference[n] + 1e-3 * Vec3(0.3 * n, -0.2, sign * (0.5 + 0.1 * n));
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    cohesive_forces(m, t, coh, laws, x, f);
+    Vec3 sum = Vec3::Zero();
+    double scale = 0;
+    for (const Vec3& fi : f) {
+      sum += fi;
+      scale += fi.norm();
+    }
+    EXPECT_GT(scale, 0.0);
+    EXPECT_LT(sum.norm(), 1e-14 * scale);
+  }
+}

@@ -1,0 +1,67 @@
+// Determinism: the facet check and the cohesive forces give identical results
+// for 1, 2 and 4 threads.
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <random>
+
+#include "fracture/cohesive_elements.hpp"
+#include "fracture_fixtures.hpp"
+
+using namespace shatter;
+
+TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
+  Mesh m = test::box_mesh(0.1, 1);
+  Topology t = build_topology(m);
+  const CohesiveLaw law = make_cohesive_law(1.0e6, 50.0, 0.8, 1.0e12);
+  const auto laws = test::one_law(law);
+  // A smooth stress field plus noise, in Voigt layout, so that a fraction of
+  // the facets is critical and many sit close to the threshold.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.2e6);
+  std::vector<double> stress(6 * m.num_elements());
+  for (Index e = 0; e < m.num_elements(); ++e) {
+    const Vec3 X = m.reference[m.element(e)[0]];
+    const double s = 0.9e6 * (1 + std::sin(7 * X.x()) * std::cos(5 * X.y()));
+    for (int i = 0; i < 6; ++i) stress[6 * e + i] = (i < 3 ? s : 0.3 * s) + noise(rng);
+  }
+  std::vector<Index> reference_facets;
+  for (int threads : {1, 2, 4}) {
+    tbb::task_arena arena(threads);
+    const std::vector<Index> facets =
+        arena.execute([&] { return critical_facets(m, t, m.reference, stress, 6, laws); });
+    if (threads == 1) {
+      reference_facets = facets;
+      EXPECT_GT(facets.size(), 50u);
+      EXPECT_LT(facets.size(), static_cast<size_t>(t.num_facets()));
+      for (size_t i = 1; i < facets.size(); ++i) EXPECT_LT(t.facet_gid[facets[i - 1]], t.facet_gid[facets[i]]);
+    } else {
+      EXPECT_EQ(facets, reference_facets) << threads << " threads";
+    }
+  }
+
+  CohesiveElements coh;
+  const Insertion ins = insert_cohesive_elements(m, t, coh, reference_facets);
+  std::vector<Vec3> x(m.num_nodes());
+  std::uniform_real_distribution<double> u(-1e-5, 1e-5);
+  for (Index n = 0; n < m.num_nodes(); ++n) x[n] = m.reference[n] + Vec3(u(rng), u(rng), u(rng));
+  std::vector<Vec3> reference_force;
+  CohesiveEnergy reference_energy;
+  for (int threads : {1, 2, 4}) {
+    CohesiveElements state = coh;
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    tbb::task_arena arena(threads);
+    const CohesiveEnergy energy = arena.execute([&] { return cohesive_forces(m, t, state, laws, x, f); });
+    if (threads == 1) {
+      reference_force = f;
+      reference_energy = energy;
+      EXPECT_GT(energy.dissipated, 0.0);
+    } else {
+      EXPECT_TRUE(f == reference_force) << threads << " threads";  // bitwise
+      EXPECT_EQ(energy.stored, reference_energy.stored);
+      EXPECT_EQ(energy.dissipated, reference_energy.dissipated);
+    }
+  }
+  EXPECT_GT(ins.new_nodes.size(), 0u);
+}
