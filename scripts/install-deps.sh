@@ -7,7 +7,7 @@ packages=(
   openmpi-bin libopenmpi-dev
   libtbb-dev libeigen3-dev libmetis-dev libhdf5-openmpi-dev
   libgmsh-dev libyaml-cpp-dev libcli11-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libtrilinos-zoltan-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libtrilinos-zoltan-dev libcgal-dev
   python3-matplotlib python3-numpy
 )
 missing=()
