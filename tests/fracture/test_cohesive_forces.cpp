@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 
 #include "expect_close.hpp"
 #include "fracture/cohesive_elements.hpp"
 #include "fracture/fragments.hpp"
 #include "fracture_fixtures.hpp"
 #include "kernels/neo_hookean.hpp"
+#include "kernels/tet10.hpp"
 #include "kernels/tet4.hpp"
 
 using namespace shatter;
@@ -30,6 +33,77 @@ Mesh two_tets() {
   m.elem_material = {0, 0};
   m.build_node_elements();
   return m;
+}
+
+/// The same two elements as TET10: mid-edge nodes added once per edge.
+Mesh two_tet10s() {
+  const Mesh linear = two_tets();
+  Mesh m = linear;
+  m.order = 2;
+  m.conn.clear();
+  std::map<std::array<Index, 2>, Index> mid;
+  for (Index e = 0; e < 2; ++e) {
+    const Index* c = linear.element(e);
+    std::array<Index, 10> nodes;
+    for (int a = 0; a < 4; ++a) nodes[a] = c[a];
+    for (int i = 0; i < 6; ++i) {
+      const Index a = c[kTet10Edges[i][0]], b = c[kTet10Edges[i][1]];
+      const auto key = std::array<Index, 2>{std::min(a, b), std::max(a, b)};
+      if (!mid.count(key)) {
+        mid[key] = m.num_nodes();
+        m.reference.push_back(0.5 * (linear.reference[a] + linear.reference[b]));
+        m.node_gid.push_back(m.num_nodes());
+        m.node_body.push_back(0);
+      }
+      nodes[4 + i] = mid[key];
+    }
+    m.conn.insert(m.conn.end(), nodes.begin(), nodes.end());
+  }
+  m.build_node_elements();
+  return m;
+}
+
+/// Open the facet of the two-element mesh by translating side 1 rigidly along
+/// `direction` up to 1.2 delta_c in `steps` steps; returns the work done on the
+/// cohesive element (trapezoidal rule on f . dx) and checks the total force on
+/// each side against the law at every step.
+double prescribed_opening_work(Mesh m, const CohesiveLaw& law, const Vec3& direction, int steps,
+                               CohesiveEnergy& energy) {
+  Topology t = build_topology(m);
+  CohesiveElements coh;
+  const auto laws = test::one_law(law);
+  insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
+  const int k = m.order == 1 ? 3 : 6;
+  std::vector<bool> side1(m.num_nodes(), false);
+  for (int j = 0; j < k; ++j) side1[coh.side_nodes[6 + j]] = true;
+  const Vec3 n(0, 0, -1);  // outward of element 0 through its face (0,2,1)
+  const double area = 0.5;
+  std::vector<Vec3> x, f_old;
+  double work = 0;
+  // Start just after insertion (lambda = 1e-9 delta_c), where the extrinsic
+  // traction is already sigma_c, so the trapezoidal rule is exact on the envelope.
+  for (int s = 0; s <= steps; ++s) {
+    const double lambda = 1.2 * law.delta_c * std::max(1e-9, double(s) / steps);
+    std::vector<Vec3> x_new = m.reference;
+    for (Index i = 0; i < m.num_nodes(); ++i)
+      if (side1[i]) x_new[i] += lambda * direction;
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    energy = cohesive_forces(m, t, coh, laws, x_new, f);
+    Vec3 total1 = Vec3::Zero();
+    for (Index i = 0; i < m.num_nodes(); ++i) {
+      if (s > 0) work += 0.5 * (f_old[i] + f[i]).dot(x_new[i] - x[i]);
+      if (side1[i]) total1 += f[i];
+    }
+    // A uniform opening: every point carries the same traction (checked past
+    // the first point, whose opening is at the round-off of the positions).
+    const Vec3 expected = area * cohesive_traction(law, lambda * direction, n, 0.0).traction;
+    if (s > 0) {
+      EXPECT_LT((total1 - expected).norm(), 1e-11 * law.sigma_c * area);
+    }
+    x = x_new;
+    f_old = f;
+  }
+  return work;
 }
 
 }  // namespace
@@ -121,6 +195,39 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
   ASSERT_EQ(fr.count(), 2);
   EXPECT_GT(fr.stats[0].velocity.z(), 0.0);  // element 1 (apex 4, above) moves up
   EXPECT_LT(fr.stats[1].velocity.z(), 0.0);
+}
+
+TEST(CohesiveForces, PrescribedMixedOpeningWorkIsGcTimesAreaTet4AndTet10) {
+  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 0.7, 1.0e7);
+  const Vec3 n(0, 0, -1), s = Vec3(1, 2, 0).normalized();
+  for (const Mesh& m : {two_tets(), two_tet10s()})
+    for (double angle : {0.0, 0.6, 1.2}) {
+      // Unit effective opening per unit lambda.
+      const Vec3 direction = std::cos(angle) * n + std::sin(angle) / law.beta * s;
+      CohesiveEnergy energy;
+      const double work = prescribed_opening_work(m, law, direction, 2400, energy);
+      EXPECT_CLOSE(work, 0.5 * law.fracture_energy(), 1e-8, 0) << "order " << m.order << " angle " << angle;
+      EXPECT_CLOSE(energy.dissipated, 0.5 * law.fracture_energy(), 1e-12, 0);
+    }
+}
+
+TEST(CohesiveForces, Tet10UniformOpeningLoadsOnlyMidEdgeNodes) {
+  // Integral of the 6-node facet shape functions: 0 at corners, A/3 at mid-edges.
+  Mesh m = two_tet10s();
+  Topology t = build_topology(m);
+  CohesiveElements coh;
+  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 1.0, 1.0e7);
+  insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
+  std::vector<Vec3> x = m.reference;
+  for (int j = 0; j < 6; ++j) x[coh.side_nodes[6 + j]] += 0.25 * law.delta_c * Vec3(0, 0, -1);
+  std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+  cohesive_forces(m, t, coh, test::one_law(law), x, f);
+  const double t_eff = law.sigma_c * 0.75, area = 0.5;
+  for (int j = 0; j < 6; ++j) {
+    const Vec3 expected = j < 3 ? Vec3::Zero() : Vec3(0, 0, -t_eff * area / 3);
+    EXPECT_LT((f[coh.side_nodes[6 + j]] - expected).norm(), 1e-12 * t_eff * area);
+    EXPECT_LT((f[coh.side_nodes[j]] + expected).norm(), 1e-12 * t_eff * area);
+  }
 }
 
 TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
