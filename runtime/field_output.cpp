@@ -259,13 +259,17 @@ void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
   State& s = *state_;
   const size_t n = static_cast<size_t>(mesh.num_nodes());
   const size_t e = static_cast<size_t>(mesh.num_elements());
-  const size_t k = static_cast<size_t>(mesh.nodes_per_element());
 
   // Optional fields are written when any rank has them; then every rank
   // passes them (a rank without elements passes empty spans).
   const std::array<int, 2> has_local{!frame.fragment.empty(), !frame.damage.empty()};
   std::array<int, 2> has{0, 0};
   MPI_Allreduce(has_local.data(), has.data(), 2, MPI_INT, MPI_MAX, s.comm);
+  // Likewise the element order: a rank without elements may pass a default Mesh.
+  const int local_order = e > 0 ? mesh.order : 1;
+  int order = 1;
+  MPI_Allreduce(&local_order, &order, 1, MPI_INT, MPI_MAX, s.comm);
+  const size_t k = order == 1 ? 4 : 10;  // topology columns
 
   std::ostringstream error;
   auto expect_size = [&](const char* name, size_t size, size_t want) {
@@ -273,6 +277,9 @@ void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
       error << "fields output, step " << frame.step << ": " << name << " has " << size
             << " entries, expected " << want;
   };
+  if (e > 0 && mesh.order != order)
+    error << "fields output, step " << frame.step << ": mesh order " << mesh.order
+          << " on this rank, " << order << " on another";
   expect_size("mesh.conn", mesh.conn.size(), e * k);
   expect_size("displacement", frame.displacement.size(), n);
   expect_size("velocity", frame.velocity.size(), n);
@@ -294,9 +301,9 @@ void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
   const Rows elem_rows{static_cast<hsize_t>(e), static_cast<hsize_t>(offset[1]),
                        static_cast<hsize_t>(total[1])};
 
-  int changed_local = s.mesh_count == 0 || mesh.revision != s.mesh_revision ||
-                      mesh.order != s.mesh_order || total[0] != s.mesh_nodes ||
-                      total[1] != s.mesh_elements;
+  const int changed_local = s.mesh_count == 0 || mesh.revision != s.mesh_revision ||
+                            order != s.mesh_order || total[0] != s.mesh_nodes ||
+                            total[1] != s.mesh_elements;
   int changed = 0;
   MPI_Allreduce(&changed_local, &changed, 1, MPI_INT, MPI_MAX, s.comm);
   if (changed) {
@@ -308,12 +315,12 @@ void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
                mesh.reference.data(), node_rows, 3);
     // Gmsh numbers the TET10 mid-edge nodes 8:(2,3) 9:(1,3); XDMF/VTK 8:(1,3) 9:(2,3).
     std::vector<std::int64_t> topology(mesh.conn.begin(), mesh.conn.end());
-    if (mesh.order == 2)
+    if (order == 2)
       for (size_t i = 0; i < e; ++i) std::swap(topology[i * k + 8], topology[i * k + 9]);
     write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(),
                elem_rows, k);
     s.mesh_revision = mesh.revision;
-    s.mesh_order = mesh.order;
+    s.mesh_order = order;
     s.mesh_nodes = total[0];
     s.mesh_elements = total[1];
     ++s.mesh_count;

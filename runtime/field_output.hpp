@@ -20,6 +20,13 @@
 //       damage              e float64 (only when given)
 // A mesh group k = 0, 1, ... is written for the first frame and again for
 // every frame whose mesh topology changed (fracture splits nodes).
+//
+// In ParaView (checked with 5.11: Xdmf3ReaderS, Xdmf3ReaderT and the legacy
+// XDMF Reader) the frames are time steps, TET10 cells are quadratic
+// tetrahedra and "Warp By Vector" on displacement shows the deformed shape.
+// The legacy reader expands stress to the full 3x3 tensor; the Xdmf3 readers
+// pass its 6 components through in file order (xx xy xz yy yz zz), which the
+// ParaView GUI labels in VTK's order (XX YY ZZ XY YZ XZ).
 #include <mpi.h>
 
 #include <filesystem>
