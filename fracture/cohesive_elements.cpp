@@ -88,43 +88,55 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
                                std::span<const Vec3> x, std::span<Vec3> f_int) {
   const int k = mesh.order == 1 ? 3 : 6;
   const Index nc = coh.size();
-  std::vector<Vec3> local_force(static_cast<size_t>(nc) * 2 * kSlots, Vec3::Zero());
-  std::vector<CohesiveEnergy> local_energy(nc);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nc, 256), [&](const tbb::blocked_range<Index>& r) {
-    for (Index c = r.begin(); c != r.end(); ++c) {
-      const CohesiveLaw& law = *facet_law(mesh, topo, laws, coh.facet[c]);
-      const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
-      const Index* side1 = side0 + kSlots;
-      // Mid-surface normal from the corners, pointing from side 0 to side 1.
-      std::array<Vec3, 3> mid;
-      for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
-      const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
-      Vec3* f = local_force.data() + static_cast<size_t>(c) * 2 * kSlots;
-      CohesiveEnergy& energy = local_energy[c];
-      for (int q = 0; q < kCohesivePoints; ++q) {
-        const std::array<double, 6> N = facet_shape(facet_points()[q], k);
-        Vec3 opening = Vec3::Zero();
-        for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
-        double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
-        const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
-        delta_max = t.delta_max;
-        const double w = coh.area[c] / kCohesivePoints;
-        for (int j = 0; j < k; ++j) {
-          f[kSlots + j] += (w * N[j]) * t.traction;
-          f[j] -= (w * N[j]) * t.traction;
-        }
-        energy.stored += w * t.stored;
-        energy.dissipated += w * t.dissipated;
-      }
-    }
-  });
+  // Blocks of elements: local forces computed in parallel into a buffer that
+  // stays in cache, then scattered serially in element order, so the sums
+  // do not depend on the threads.
+  constexpr Index kBlock = 4096;
+  std::vector<Vec3> local_force(static_cast<size_t>(std::min(nc, kBlock)) * 2 * k);
+  std::vector<CohesiveEnergy> local_energy(std::min(nc, kBlock));
   CohesiveEnergy total;
-  for (Index c = 0; c < nc; ++c) {
-    const size_t base = static_cast<size_t>(c) * 2 * kSlots;
-    for (int s = 0; s < 2; ++s)
-      for (int j = 0; j < k; ++j) f_int[coh.side_nodes[base + s * kSlots + j]] += local_force[base + s * kSlots + j];
-    total.stored += local_energy[c].stored;
-    total.dissipated += local_energy[c].dissipated;
+  for (Index first = 0; first < nc; first += kBlock) {
+    const Index last = std::min(nc, first + kBlock);
+    tbb::parallel_for(tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
+      for (Index c = r.begin(); c != r.end(); ++c) {
+        const CohesiveLaw& law = *facet_law(mesh, topo, laws, coh.facet[c]);
+        const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+        const Index* side1 = side0 + kSlots;
+        // Mid-surface normal from the corners, pointing from side 0 to side 1.
+        std::array<Vec3, 3> mid;
+        for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
+        const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
+        Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
+        std::fill(f, f + 2 * k, Vec3::Zero());
+        CohesiveEnergy& energy = local_energy[c - first];
+        energy = CohesiveEnergy{};
+        for (int q = 0; q < kCohesivePoints; ++q) {
+          const std::array<double, 6> N = facet_shape(facet_points()[q], k);
+          Vec3 opening = Vec3::Zero();
+          for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
+          double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
+          const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
+          delta_max = t.delta_max;
+          const double w = coh.area[c] / kCohesivePoints;
+          for (int j = 0; j < k; ++j) {
+            f[k + j] += (w * N[j]) * t.traction;
+            f[j] -= (w * N[j]) * t.traction;
+          }
+          energy.stored += w * t.stored;
+          energy.dissipated += w * t.dissipated;
+        }
+      }
+    });
+    for (Index c = first; c < last; ++c) {
+      const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+      const Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
+      for (int j = 0; j < k; ++j) {
+        f_int[nodes[j]] += f[j];
+        f_int[nodes[kSlots + j]] += f[k + j];
+      }
+      total.stored += local_energy[c - first].stored;
+      total.dissipated += local_energy[c - first].dissipated;
+    }
   }
   return total;
 }
