@@ -3,7 +3,7 @@
 #   make test   install dependencies, build, run every test
 BUILD ?= build
 JOBS  ?= $(shell nproc)
-SCENE ?= scenes/default.yaml
+SCENE ?= scenes/bar_wave.yaml
 THREADS ?= $(shell nproc)
 
 .PHONY: all deps build run test bench clean

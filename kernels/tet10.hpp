@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "kernels/neo_hookean.hpp"
+#include "kernels/tet4.hpp"
 #include "kernels/types.hpp"
 
 namespace shatter {
@@ -129,6 +130,17 @@ inline Eigen::Matrix<double, 10, 1> tet10_hrz_mass_fractions(const Tet10Nodes& X
         diag += (wt * detJ) * tet10_shape(p).cwiseAbs2();
       }
   return diag / diag.sum();
+}
+
+}  // namespace shatter
+
+namespace shatter {
+
+/// Characteristic length of a TET10 with HRZ masses for dt = h / c_d: a quarter
+/// of the smallest altitude of its corner tetrahedron (the element eigenvalue
+/// bound falls to 0.275 x altitude / c_d at nu = 0.49; see test_stable_dt.cpp).
+inline double tet10_stable_length(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return 0.25 * tet_min_altitude(a, b, c, d);
 }
 
 }  // namespace shatter

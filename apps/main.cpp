@@ -1,0 +1,123 @@
+// shatter — command line (SCENE.md "Command line"):
+//   shatter run SCENE.yaml [--out DIR] [--threads T] [--set key.path=value ...]
+//             [--deterministic] [--restart CHECKPOINT.h5] [--quiet]
+//   shatter check SCENE.yaml [--set ...]
+// Exit status: 0 success, 2 bad input, 1 failure during the run.
+#include <mpi.h>
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <thread>
+
+#include "kernels/error.hpp"
+#include "runtime/model.hpp"
+#include "runtime/report.hpp"
+#include "runtime/scene.hpp"
+#include "runtime/simulation.hpp"
+
+using namespace shatter;
+
+namespace {
+
+void print_check(const Model& model, const Simulation& sim) {
+  const Scene& s = model.scene;
+  const Mesh& mesh = model.mesh;
+  std::printf("scene %s (%s)\n", s.name.c_str(), s.file.c_str());
+  std::printf("%-12s %-12s %10s %10s %14s %14s\n", "body", "material", "nodes", "elements", "mass [kg]", "volume [m^3]");
+  for (size_t b = 0; b < s.bodies.size(); ++b) {
+    long nodes = 0, elems = 0;
+    for (Index i = 0; i < mesh.num_nodes(); ++i) nodes += mesh.node_body[i] == int(b);
+    for (Index e = 0; e < mesh.num_elements(); ++e) elems += mesh.elem_body[e] == int(b);
+    std::printf("%-12s %-12s %10ld %10ld %14.6e %14.6e\n", s.bodies[b].name.c_str(),
+                s.materials[s.bodies[b].material].name.c_str(), nodes, elems, model.body_mass[b], model.body_volume[b]);
+  }
+  double mass = 0;
+  for (double m : model.body_mass) mass += m;
+  std::printf("total: %d nodes, %d elements (TET%d), mass %.6e kg\n", mesh.num_nodes(), mesh.num_elements(),
+              mesh.nodes_per_element(), mass);
+  const double dt = s.fixed_dt ? *s.fixed_dt : sim.stable_dt();
+  std::printf("stable dt %.4e s (safety %.2f)%s; dt used %.4e s\n", sim.stable_dt() / s.safety, s.safety,
+              s.fixed_dt && *s.fixed_dt > sim.stable_dt() ? "  WARNING: time.dt is above it" : "", dt);
+  const double steps = std::ceil(s.end_time / dt);
+  std::printf("end time %.4e s: about %.0f steps\n", s.end_time, steps);
+  std::printf("contact: %s; fracture: %s; gravity: [%g, %g, %g]; boundary conditions: %zu\n",
+              s.contact ? "on" : "off", s.fracture_enabled() ? "on" : "off", s.gravity.x(), s.gravity.y(),
+              s.gravity.z(), s.boundary_conditions.size());
+  // The model arrays plus the solver's five nodal vectors and work arrays.
+  const double state = double(mesh.num_nodes()) * (5 * sizeof(Vec3) + sizeof(double));
+  std::printf("memory: about %.1f MB\n", (model_bytes(model) + state) / 1e6);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+
+  CLI::App app{"shatter: explicit dynamics of solids that collide, crack and fragment"};
+  app.require_subcommand(1);
+  std::string scene_path, out_dir, restart;
+  std::vector<std::string> overrides;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  bool deterministic = false, quiet = false;
+
+  auto* run = app.add_subcommand("run", "run a scene");
+  run->add_option("scene", scene_path, "scene file (YAML)")->required();
+  run->add_option("--out", out_dir, "output folder (default out/<name>)");
+  run->add_option("--threads", threads, "oneTBB threads per rank")->check(CLI::PositiveNumber);
+  run->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+  run->add_flag("--deterministic", deterministic, "bitwise identical results for any ranks and threads");
+  run->add_option("--restart", restart, "continue from a checkpoint");
+  run->add_flag("--quiet", quiet, "no progress line");
+  auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
+  check->add_option("scene", scene_path, "scene file (YAML)")->required();
+  check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+
+  int status = 0;
+  try {
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      const int rc = app.exit(e);
+      MPI_Finalize();
+      return rc == 0 ? 0 : 2;
+    }
+    if (!restart.empty()) throw InputError("--restart " + restart + ": checkpoint/restart is not implemented yet");
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    const Scene scene = load_scene(scene_path, overrides);
+    Model model = build_model(scene);
+    RunOptions opt;
+    opt.threads = threads;
+    opt.ranks = ranks;
+    opt.quiet = quiet;
+    opt.deterministic = deterministic;
+    if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
+    Simulation sim(model, opt);
+    if (*check) {
+      print_check(model, sim);
+    } else {
+      if (scene.checkpoint && !quiet && rank == 0)
+        std::fprintf(stderr, "warning: %s: checkpoint: checkpoints are not written yet; the key is ignored\n",
+                     scene.file.c_str());
+      const long steps = sim.run();
+      if (!quiet && rank == 0)
+        std::fprintf(stderr, "done: %ld steps, energy error %.2e; outputs in %s\n", steps,
+                     sim.energy_error(), opt.out_dir.c_str());
+    }
+  } catch (const InputError& e) {
+    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
+    status = 2;
+  } catch (const Error& e) {
+    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
+    status = 1;
+  } catch (const std::exception& e) {
+    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
+    status = 1;
+  }
+  MPI_Finalize();
+  return status;
+}

@@ -1,0 +1,130 @@
+#include "runtime/model.hpp"
+
+#include <sstream>
+
+#include "kernels/error.hpp"
+#include "kernels/tet4.hpp"
+#include "mesh/gmsh_input.hpp"
+
+namespace shatter {
+
+Model build_model(const Scene& scene) {
+  Model m;
+  m.scene = scene;
+  for (const auto& ms : scene.materials)
+    m.materials.push_back(NeoHookean::from_young_poisson(ms.young, ms.poisson, ms.density));
+
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodySpec& body = scene.bodies[b];
+    const std::string where = scene.file + ": " + body.key + ".mesh" +
+                              (body.mesh_file.empty() ? "" : " (" + body.mesh_file + ")");
+    Mesh part = body.mesh_file.empty()
+                    ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
+                    : read_msh(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
+    validate_mesh(part, where);
+    if (m.mesh.num_elements() > 0 && part.order != m.mesh.order)
+      throw InputError(where + ": element order " + std::to_string(part.order) +
+                       " differs from the first body's; expected one order for all bodies");
+    append_mesh(m.mesh, part);
+  }
+
+  const Mesh& mesh = m.mesh;
+  const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
+  const int k = mesh.nodes_per_element();
+  m.element_volume.resize(ne);
+  m.element_node_mass.resize(static_cast<size_t>(ne) * k);
+  if (mesh.order == 1) m.tet4_Dm_inv.resize(ne);
+  else m.tet10_ref.resize(ne);
+  for (Index e = 0; e < ne; ++e) {
+    const Index* c = mesh.element(e);
+    const double rho = m.materials[mesh.elem_material[e]].density;
+    if (mesh.order == 1) {
+      const Tet4Reference r = tet4_reference(mesh.reference[c[0]], mesh.reference[c[1]], mesh.reference[c[2]],
+                                             mesh.reference[c[3]]);
+      m.tet4_Dm_inv[e] = r.Dm_inv;
+      m.element_volume[e] = r.volume;
+      for (int a = 0; a < 4; ++a) m.element_node_mass[e * 4 + a] = 0.25 * rho * r.volume;  // row sum
+    } else {
+      Tet10Nodes X;
+      for (int a = 0; a < 10; ++a) X.col(a) = mesh.reference[c[a]];
+      m.tet10_ref[e] = tet10_reference(X);
+      m.element_volume[e] = m.tet10_ref[e].volume;
+      const auto frac = tet10_hrz_mass_fractions(X);
+      for (int a = 0; a < 10; ++a) m.element_node_mass[e * 10 + a] = frac[a] * rho * m.element_volume[e];
+    }
+  }
+  std::vector<Index> all(nn);
+  for (Index i = 0; i < nn; ++i) all[i] = i;
+  m.mass.assign(nn, 0.0);
+  recompute_node_masses(m, all);
+
+  const int nb = static_cast<int>(scene.bodies.size());
+  m.body_mass.assign(nb, 0.0);
+  m.body_volume.assign(nb, 0.0);
+  for (Index e = 0; e < ne; ++e) {
+    m.body_volume[mesh.elem_body[e]] += m.element_volume[e];
+    m.body_mass[mesh.elem_body[e]] += m.element_volume[e] * m.materials[mesh.elem_material[e]].density;
+  }
+
+  // Initial velocities: translation, rotation about the body's centre of
+  // mass, and a velocity gradient about the same centre.
+  std::vector<Vec3> centre(nb, Vec3::Zero());
+  for (Index i = 0; i < nn; ++i) centre[mesh.node_body[i]] += m.mass[i] * mesh.reference[i];
+  for (int b = 0; b < nb; ++b) centre[b] /= m.body_mass[b];
+  m.initial_velocity.resize(nn);
+  for (Index i = 0; i < nn; ++i) {
+    const BodySpec& body = scene.bodies[mesh.node_body[i]];
+    const Vec3 r = mesh.reference[i] - centre[mesh.node_body[i]];
+    Vec3 v = body.initial_velocity + body.angular_velocity.cross(r);
+    if (body.velocity_gradient) v += *body.velocity_gradient * r;
+    m.initial_velocity[i] = v;
+  }
+
+  m.bc_mask.assign(nn, 0);
+  m.bc_velocity.assign(nn, Vec3::Zero());
+  for (const auto& bc : scene.boundary_conditions) {
+    Index hits = 0;
+    for (Index i = 0; i < nn; ++i) {
+      if (mesh.node_body[i] != bc.body) continue;
+      const Vec3& X = mesh.reference[i];
+      if ((X.array() < bc.box_lo.array()).any() || (X.array() > bc.box_hi.array()).any()) continue;
+      ++hits;
+      for (int c = 0; c < 3; ++c)
+        if (bc.velocity[c]) {
+          m.bc_mask[i] |= static_cast<std::uint8_t>(1u << c);
+          m.bc_velocity[i][c] = *bc.velocity[c];
+          m.initial_velocity[i][c] = *bc.velocity[c];
+        }
+    }
+    if (hits == 0)
+      throw InputError(scene.file + ": " + bc.key + ".region: the box holds no node of body '" +
+                       scene.bodies[bc.body].name + "'; expected a box around some of its nodes");
+  }
+  return m;
+}
+
+void recompute_node_masses(Model& model, const std::vector<Index>& nodes) {
+  const Mesh& mesh = model.mesh;
+  const int k = mesh.nodes_per_element();
+  for (Index i : nodes) {
+    double sum = 0;
+    for (Index p = mesh.node_elem_offsets[i]; p < mesh.node_elem_offsets[i + 1]; ++p) {
+      const Index e = mesh.node_elem[p];
+      const Index* c = mesh.element(e);
+      for (int a = 0; a < k; ++a)
+        if (c[a] == i) sum += model.element_node_mass[static_cast<size_t>(e) * k + a];
+    }
+    model.mass[i] = sum;
+  }
+}
+
+std::size_t model_bytes(const Model& m) {
+  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  const Mesh& mesh = m.mesh;
+  return b(mesh.reference) + b(mesh.node_gid) + b(mesh.node_body) + b(mesh.conn) + b(mesh.elem_gid) +
+         b(mesh.elem_body) + b(mesh.elem_material) + b(mesh.node_elem_offsets) + b(mesh.node_elem) +
+         b(m.tet4_Dm_inv) + b(m.tet10_ref) + b(m.element_volume) + b(m.element_node_mass) + b(m.mass) +
+         b(m.bc_mask) + b(m.bc_velocity) + b(m.initial_velocity);
+}
+
+}  // namespace shatter

@@ -1,0 +1,348 @@
+#include "runtime/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+namespace {
+
+// Reader of one scene file: every accessor checks type and range and names
+// the key path in its message.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& expected, const YAML::Node& got) const {
+    std::ostringstream os;
+    os << file_ << ": " << key << ": expected " << expected;
+    if (got.IsDefined() && !got.IsNull()) {
+      YAML::Emitter e;
+      e << YAML::Flow << got;
+      os << ", got '" << e.c_str() << "'";
+    } else {
+      os << ", but it is missing";
+    }
+    throw InputError(os.str());
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+    throw InputError(file_ + ": " + key + ": " + message);
+  }
+
+  void only_keys(const YAML::Node& map, const std::string& key, std::initializer_list<const char*> allowed) const {
+    if (!map.IsMap()) fail(key.empty() ? "(top level)" : key, "a mapping", map);
+    std::set<std::string> ok(allowed.begin(), allowed.end());
+    for (const auto& kv : map) {
+      const std::string k = kv.first.as<std::string>();
+      if (!ok.count(k)) {
+        std::string list;
+        for (const auto& a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        fail(join(key, k), "unknown key; expected one of: " + list);
+      }
+    }
+  }
+
+  static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
+
+  double number(const YAML::Node& n, const std::string& key, const char* expected = "a number") const {
+    if (!n.IsScalar()) fail(key, expected, n);
+    double v = 0;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(key, expected, n);
+    }
+    if (!std::isfinite(v)) fail(key, expected, n);
+    return v;
+  }
+  double positive(const YAML::Node& n, const std::string& key) const {
+    const double v = number(n, key, "a positive number");
+    if (!(v > 0)) fail(key, "a positive number", n);
+    return v;
+  }
+  long count(const YAML::Node& n, const std::string& key, long min) const {
+    if (!n.IsScalar()) fail(key, "an integer >= " + std::to_string(min), n);
+    try {
+      const long v = n.as<long>();
+      if (v < min) fail(key, "an integer >= " + std::to_string(min), n);
+      return v;
+    } catch (const YAML::Exception&) {
+      fail(key, "an integer >= " + std::to_string(min), n);
+    }
+  }
+  std::string string(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar() || n.Tag() == "?" && n.as<std::string>().empty()) fail(key, "a string", n);
+    return n.as<std::string>();
+  }
+  Vec3 vec3(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 3) fail(key, "a list of 3 numbers [x, y, z]", n);
+    return Vec3(number(n[0], key + "[0]"), number(n[1], key + "[1]"), number(n[2], key + "[2]"));
+  }
+  Mat3 mat3(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 3) fail(key, "a 3x3 matrix [[..],[..],[..]] in 1/s", n);
+    Mat3 m;
+    for (int i = 0; i < 3; ++i) m.row(i) = vec3(n[i], key + "[" + std::to_string(i) + "]").transpose();
+    return m;
+  }
+  const YAML::Node required(const YAML::Node& map, const std::string& parent, const char* k) const {
+    const YAML::Node n = map[k];
+    if (!n.IsDefined() || n.IsNull()) fail(join(parent, k), "a value (required key)", n);
+    return n;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// Walk a key path like bodies[0].mesh.element_size and return the node to set.
+YAML::Node walk(YAML::Node root, const std::string& path, const std::string& file) {
+  YAML::Node node = root;
+  std::size_t i = 0;
+  auto bad = [&](const std::string& why) {
+    throw InputError("--set " + path + ": " + why + " (scene " + file + ")");
+  };
+  while (i < path.size()) {
+    std::size_t j = path.find_first_of(".[", i);
+    const std::string name = path.substr(i, j == std::string::npos ? std::string::npos : j - i);
+    if (name.empty()) bad("expected a key path like time.safety or bodies[0].mesh.element_size");
+    node.reset(node[name]);
+    i = j == std::string::npos ? path.size() : j;
+    while (i < path.size() && path[i] == '[') {
+      const std::size_t close = path.find(']', i);
+      if (close == std::string::npos) bad("unclosed '['");
+      std::size_t idx = 0;
+      try {
+        idx = std::stoul(path.substr(i + 1, close - i - 1));
+      } catch (...) {
+        bad("expected an index inside [ ]");
+      }
+      if (!node.IsSequence() || idx >= node.size()) bad("index " + std::to_string(idx) + " is out of range");
+      node.reset(node[idx]);
+      i = close + 1;
+    }
+    if (i < path.size() && path[i] == '.') ++i;
+  }
+  return node;
+}
+
+ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& key) {
+  ShapeSpec s;
+  s.shape = r.string(r.required(m, key, "shape"), key + ".shape");
+  if (s.shape == "box") {
+    r.only_keys(m, key, {"shape", "size", "center", "element_size", "order"});
+    s.size = r.vec3(r.required(m, key, "size"), key + ".size");
+    if ((s.size.array() <= 0).any()) r.fail(key + ".size", "three positive lengths", m["size"]);
+  } else if (s.shape == "cylinder" || s.shape == "sphere") {
+    if (s.shape == "cylinder")
+      r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size", "order"});
+    else
+      r.only_keys(m, key, {"shape", "radius", "center", "element_size", "order"});
+    s.radius = r.positive(r.required(m, key, "radius"), key + ".radius");
+    if (s.shape == "cylinder") s.length = r.positive(r.required(m, key, "length"), key + ".length");
+  } else if (s.shape == "tube") {
+    r.only_keys(m, key, {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order"});
+    s.inner_radius = r.positive(r.required(m, key, "inner_radius"), key + ".inner_radius");
+    s.outer_radius = r.positive(r.required(m, key, "outer_radius"), key + ".outer_radius");
+    if (s.outer_radius <= s.inner_radius)
+      r.fail(key + ".outer_radius", "a value larger than inner_radius", m["outer_radius"]);
+    s.length = r.positive(r.required(m, key, "length"), key + ".length");
+  } else {
+    r.fail(key + ".shape", "one of box, cylinder, sphere, tube", m["shape"]);
+  }
+  if (m["center"]) s.center = r.vec3(m["center"], key + ".center");
+  if (m["axis"]) {
+    s.axis = r.vec3(m["axis"], key + ".axis");
+    if (s.axis.norm() == 0) r.fail(key + ".axis", "a non-zero direction", m["axis"]);
+  }
+  s.element_size = r.positive(r.required(m, key, "element_size"), key + ".element_size");
+  return s;
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  Reader r(path);
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(path + ": the scene file does not exist or is not a file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    std::ostringstream os;
+    os << path << ":" << e.mark.line + 1 << ":" << e.mark.column + 1 << ": not valid YAML: " << e.msg;
+    throw InputError(os.str());
+  }
+  for (const std::string& o : overrides) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--set " + o + ": expected key.path=value");
+    YAML::Node target = walk(root, o.substr(0, eq), path);
+    try {
+      target = YAML::Load(o.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      throw InputError("--set " + o + ": the value is not valid YAML: " + e.msg);
+    }
+  }
+  r.only_keys(root, "", {"name", "time", "output", "materials", "bodies", "boundary_conditions", "contact",
+                         "gravity", "checkpoint"});
+  Scene s;
+  s.file = path;
+  s.name = r.string(r.required(root, "", "name"), "name");
+  if (s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
+    r.fail("name", "a plain name usable as a folder name (no '/')", root["name"]);
+
+  const YAML::Node time = r.required(root, "", "time");
+  r.only_keys(time, "time", {"end", "dt", "safety"});
+  s.end_time = r.positive(r.required(time, "time", "end"), "time.end");
+  if (time["dt"]) s.fixed_dt = r.positive(time["dt"], "time.dt");
+  if (time["safety"]) {
+    s.safety = r.positive(time["safety"], "time.safety");
+    if (s.safety > 1.0) r.fail("time.safety", "a fraction of the stable step in (0, 1]", time["safety"]);
+  }
+
+  if (const YAML::Node out = root["output"]) {
+    r.only_keys(out, "output", {"every", "history_every"});
+    if (out["every"]) s.output_every = r.count(out["every"], "output.every", 0);
+    if (out["history_every"]) s.history_every = r.count(out["history_every"], "output.history_every", 1);
+  }
+
+  const YAML::Node mats = r.required(root, "", "materials");
+  if (!mats.IsMap() || mats.size() == 0) r.fail("materials", "a mapping of material names to materials", mats);
+  for (const auto& kv : mats) {
+    MaterialSpec m;
+    m.name = kv.first.as<std::string>();
+    const std::string key = "materials." + m.name;
+    const YAML::Node n = kv.second;
+    r.only_keys(n, key, {"model", "density", "youngs_modulus", "poisson_ratio", "fracture"});
+    m.model = r.string(r.required(n, key, "model"), key + ".model");
+    if (m.model != "neo_hookean") r.fail(key + ".model", "neo_hookean (the only model so far)", n["model"]);
+    m.density = r.positive(r.required(n, key, "density"), key + ".density");
+    m.young = r.positive(r.required(n, key, "youngs_modulus"), key + ".youngs_modulus");
+    m.poisson = r.number(r.required(n, key, "poisson_ratio"), key + ".poisson_ratio");
+    if (!(m.poisson > -1.0 && m.poisson < 0.5))
+      r.fail(key + ".poisson_ratio", "a Poisson ratio in (-1, 0.5)", n["poisson_ratio"]);
+    if (const YAML::Node f = n["fracture"]) {
+      const std::string fk = key + ".fracture";
+      r.only_keys(f, fk, {"strength", "energy", "beta"});
+      FractureSpec fs;
+      fs.strength = r.positive(r.required(f, fk, "strength"), fk + ".strength");
+      fs.energy = r.positive(r.required(f, fk, "energy"), fk + ".energy");
+      if (f["beta"]) fs.beta = r.positive(f["beta"], fk + ".beta");
+      m.fracture = fs;
+    }
+    s.materials.push_back(m);
+  }
+
+  const YAML::Node bodies = r.required(root, "", "bodies");
+  if (!bodies.IsSequence() || bodies.size() == 0) r.fail("bodies", "a non-empty list of bodies", bodies);
+  const std::filesystem::path scene_dir = std::filesystem::path(path).parent_path();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::string key = "bodies[" + std::to_string(i) + "]";
+    const YAML::Node b = bodies[i];
+    r.only_keys(b, key, {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient"});
+    BodySpec body;
+    body.key = key;
+    body.name = b["name"] ? r.string(b["name"], key + ".name") : "body" + std::to_string(i);
+    for (const auto& other : s.bodies)
+      if (other.name == body.name) r.fail(key + ".name", "a name no other body has", b["name"]);
+    const std::string mat = r.string(r.required(b, key, "material"), key + ".material");
+    body.material = -1;
+    for (std::size_t m = 0; m < s.materials.size(); ++m)
+      if (s.materials[m].name == mat) body.material = static_cast<int>(m);
+    if (body.material < 0) r.fail(key + ".material", "the name of a material under 'materials'", b["material"]);
+    const YAML::Node mesh = r.required(b, key, "mesh");
+    const std::string mk = key + ".mesh";
+    if (!mesh.IsMap()) r.fail(mk, "a mapping with either 'file' or 'shape'", mesh);
+    if (mesh["file"] && mesh["shape"]) r.fail(mk, "exactly one of 'file' or 'shape', not both");
+    if (mesh["file"]) {
+      r.only_keys(mesh, mk, {"file", "physical", "order"});
+      const std::filesystem::path f = r.string(mesh["file"], mk + ".file");
+      body.mesh_file = (f.is_absolute() ? f : scene_dir / f).string();
+      if (mesh["physical"]) body.mesh_physical = r.string(mesh["physical"], mk + ".physical");
+    } else if (mesh["shape"]) {
+      body.shape = read_shape(r, mesh, mk);
+    } else {
+      r.fail(mk, "exactly one of 'file' (a Gmsh .msh) or 'shape' (box, cylinder, sphere, tube)");
+    }
+    if (mesh["order"]) {
+      const long order = r.count(mesh["order"], mk + ".order", 1);
+      if (order > 2) r.fail(mk + ".order", "1 (4-node tets) or 2 (10-node tets)", mesh["order"]);
+      body.shape.order = static_cast<int>(order);
+    }
+    if (b["initial_velocity"]) body.initial_velocity = r.vec3(b["initial_velocity"], key + ".initial_velocity");
+    if (b["angular_velocity"]) body.angular_velocity = r.vec3(b["angular_velocity"], key + ".angular_velocity");
+    if (b["velocity_gradient"]) body.velocity_gradient = r.mat3(b["velocity_gradient"], key + ".velocity_gradient");
+    s.bodies.push_back(body);
+  }
+  for (const auto& b : s.bodies)
+    if (b.mesh_file.empty() && b.shape.order != s.bodies[0].shape.order)
+      r.fail(b.key + ".mesh.order", "the same element order for every body");
+
+  if (const YAML::Node bcs = root["boundary_conditions"]) {
+    if (!bcs.IsSequence()) r.fail("boundary_conditions", "a list of boundary conditions", bcs);
+    for (std::size_t i = 0; i < bcs.size(); ++i) {
+      const std::string key = "boundary_conditions[" + std::to_string(i) + "]";
+      const YAML::Node c = bcs[i];
+      r.only_keys(c, key, {"body", "region", "velocity"});
+      BoundaryConditionSpec bc;
+      bc.key = key;
+      const std::string body = r.string(r.required(c, key, "body"), key + ".body");
+      bc.body = -1;
+      for (std::size_t k = 0; k < s.bodies.size(); ++k)
+        if (s.bodies[k].name == body) bc.body = static_cast<int>(k);
+      if (bc.body < 0) r.fail(key + ".body", "the name of a body", c["body"]);
+      const YAML::Node region = r.required(c, key, "region");
+      r.only_keys(region, key + ".region", {"box"});
+      const YAML::Node box = r.required(region, key + ".region", "box");
+      const std::string bk = key + ".region.box";
+      if (!box.IsSequence() || box.size() != 2) r.fail(bk, "[[xmin, ymin, zmin], [xmax, ymax, zmax]]", box);
+      bc.box_lo = r.vec3(box[0], bk + "[0]");
+      bc.box_hi = r.vec3(box[1], bk + "[1]");
+      if ((bc.box_lo.array() > bc.box_hi.array()).any()) r.fail(bk, "min corner <= max corner", box);
+      const YAML::Node v = r.required(c, key, "velocity");
+      if (!v.IsSequence() || v.size() != 3) r.fail(key + ".velocity", "[vx, vy, vz] with null for free components", v);
+      bool any = false;
+      for (int k = 0; k < 3; ++k)
+        if (!v[k].IsNull()) {
+          bc.velocity[k] = r.number(v[k], key + ".velocity[" + std::to_string(k) + "]");
+          any = true;
+        }
+      if (!any) r.fail(key + ".velocity", "at least one prescribed (non-null) component", v);
+      s.boundary_conditions.push_back(bc);
+    }
+  }
+
+  if (const YAML::Node c = root["contact"]) {
+    ContactSpec cs;
+    if (!c.IsNull()) {
+      r.only_keys(c, "contact", {"friction", "restitution"});
+      if (c["friction"]) {
+        cs.friction = r.number(c["friction"], "contact.friction");
+        if (cs.friction < 0) r.fail("contact.friction", "a Coulomb coefficient >= 0", c["friction"]);
+      }
+      if (c["restitution"]) {
+        cs.restitution = r.number(c["restitution"], "contact.restitution");
+        if (cs.restitution < 0 || cs.restitution > 1) r.fail("contact.restitution", "a value in [0, 1]", c["restitution"]);
+      }
+    }
+    s.contact = cs;
+  }
+  if (root["gravity"]) s.gravity = r.vec3(root["gravity"], "gravity");
+  if (const YAML::Node c = root["checkpoint"]) {
+    r.only_keys(c, "checkpoint", {"every_steps", "every_seconds"});
+    CheckpointSpec cp;
+    if (c["every_steps"]) cp.every_steps = r.count(c["every_steps"], "checkpoint.every_steps", 1);
+    if (c["every_seconds"]) cp.every_seconds = r.positive(c["every_seconds"], "checkpoint.every_seconds");
+    s.checkpoint = cp;
+  }
+  return s;
+}
+
+}  // namespace shatter

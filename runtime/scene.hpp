@@ -1,0 +1,85 @@
+#pragma once
+// Scene files (the contract in SCENE.md): loaded with yaml-cpp, checked
+// strictly before anything runs. Every error is an InputError naming the
+// file, the key path (bodies[1].mesh.radius) and what was expected.
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kernels/types.hpp"
+#include "mesh/gmsh_input.hpp"
+
+namespace shatter {
+
+struct FractureSpec {
+  double strength = 0;  ///< sigma_c, Pa
+  double energy = 0;    ///< Gc, J/m^2
+  double beta = 1.0;    ///< shear/normal strength ratio
+};
+
+struct MaterialSpec {
+  std::string name;
+  std::string model;     ///< neo_hookean
+  double density = 0;    ///< kg/m^3
+  double young = 0;      ///< Pa
+  double poisson = 0;
+  std::optional<FractureSpec> fracture;
+};
+
+struct BodySpec {
+  std::string name;
+  int material = 0;            ///< index into Scene::materials
+  std::string mesh_file;       ///< .msh path (resolved against the scene's folder); empty: shape
+  std::string mesh_physical;   ///< optional physical volume name in the file
+  ShapeSpec shape;
+  Vec3 initial_velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+  std::optional<Mat3> velocity_gradient;
+  std::string key;             ///< "bodies[i]", for messages
+};
+
+struct BoundaryConditionSpec {
+  int body = 0;
+  Vec3 box_lo, box_hi;                          ///< nodes inside (inclusive) get the velocity
+  std::array<std::optional<double>, 3> velocity;  ///< prescribed components, m/s
+  std::string key;
+};
+
+struct ContactSpec {
+  double friction = 0.0;     ///< Coulomb mu
+  double restitution = 1.0;  ///< e in [0, 1]
+};
+
+struct CheckpointSpec {
+  long every_steps = 0;
+  double every_seconds = 0;
+};
+
+struct Scene {
+  std::string file;  ///< path of the scene file
+  std::string name;
+  double end_time = 0;
+  std::optional<double> fixed_dt;
+  double safety = 0.5;
+  long output_every = -1;  ///< steps between field outputs; -1 = default (about 20 frames)
+  long history_every = 1;
+  std::vector<MaterialSpec> materials;
+  std::vector<BodySpec> bodies;
+  std::vector<BoundaryConditionSpec> boundary_conditions;
+  std::optional<ContactSpec> contact;
+  Vec3 gravity = Vec3::Zero();
+  std::optional<CheckpointSpec> checkpoint;
+
+  bool fracture_enabled() const {
+    for (const auto& m : materials)
+      if (m.fracture) return true;
+    return false;
+  }
+};
+
+/// Load and check a scene. `overrides` are "key.path=value" strings (the
+/// CLI's --set), applied to the YAML tree before checking; value is YAML.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+}  // namespace shatter

@@ -1,0 +1,279 @@
+#include "runtime/simulation.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "kernels/error.hpp"
+#include "runtime/field_output.hpp"
+#include "runtime/parallel.hpp"
+#include "runtime/report.hpp"
+
+namespace shatter {
+namespace {
+
+struct Momenta {
+  double kinetic = 0;
+  Vec3 p = Vec3::Zero(), L = Vec3::Zero();
+  Momenta& operator+=(const Momenta& o) {
+    kinetic += o.kinetic;
+    p += o.p;
+    L += o.L;
+    return *this;
+  }
+};
+
+struct BodyRow {
+  double mass = 0;
+  Vec3 mx = Vec3::Zero(), mv = Vec3::Zero();
+};
+
+}  // namespace
+
+Simulation::Simulation(Model& model, RunOptions options)
+    : model_(model), opt_(std::move(options)), elements_(model) {
+  const Mesh& mesh = model_.mesh;
+  const Index n = mesh.num_nodes();
+  x_ = mesh.reference;
+  v_ = model_.initial_velocity;
+  a_.assign(n, Vec3::Zero());
+  f_int_.assign(n, Vec3::Zero());
+  f_ext_.assign(n, Vec3::Zero());
+  inv_mass_.resize(n);
+  for (Index i = 0; i < n; ++i) {
+    inv_mass_[i] = 1.0 / model_.mass[i];
+    if (model_.bc_mask[i]) bc_nodes_.push_back(i);
+  }
+  reaction_.assign(bc_nodes_.size(), Vec3::Zero());
+  compute_forces();
+  update_ledger();
+  total0_ = ledger_.total();
+  energy_scale_ = std::max(ledger_.kinetic + ledger_.strain, 1e-300);
+  if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && !opt_.quiet)
+    std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
+                 model_.scene.file.c_str(), *model_.scene.fixed_dt, stable_dt_);
+}
+
+Simulation::~Simulation() = default;
+
+double Simulation::next_dt() const {
+  const double dt = model_.scene.fixed_dt ? *model_.scene.fixed_dt : model_.scene.safety * stable_dt_;
+  const double remaining = model_.scene.end_time - time_;
+  // Land on end_time exactly, without a sliver of a last step.
+  return remaining < 1.5 * dt && remaining > dt ? 0.5 * remaining : std::min(dt, remaining);
+}
+
+void Simulation::compute_forces() {
+  const auto t0 = std::chrono::steady_clock::now();
+  last_elements_ = elements_.compute(x_, f_int_);
+  element_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stable_dt_ = last_elements_.stable_dt;
+  if (!(last_elements_.min_jacobian > 0)) {
+    const Index e = last_elements_.worst_element;
+    Vec3 centre = Vec3::Zero();
+    const int k = model_.mesh.nodes_per_element();
+    for (int a = 0; a < 4 && e >= 0; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
+    std::ostringstream os;
+    os << "step " << step_ << ", t = " << time_ << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
+       << " (body '" << (e >= 0 ? model_.scene.bodies[model_.mesh.elem_body[e]].name : "?") << "') "
+       << (std::isnan(last_elements_.min_jacobian) ? "has NaN coordinates" : "is inverted") << " (det F = "
+       << last_elements_.min_jacobian << ") near (" << centre.x() << ", " << centre.y() << ", " << centre.z()
+       << "); try a smaller time.safety or a finer mesh";
+    (void)k;
+    throw Error(os.str());
+  }
+  const Vec3 g = model_.scene.gravity;
+  const Index n = model_.mesh.num_nodes();
+  parallel_for_each(n, [&](Index i) {
+    f_ext_[i] = model_.mass[i] * g;
+    a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
+  });
+  // Prescribed components: no acceleration; the reaction is the force that holds them.
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) {
+    const Index i = bc_nodes_[b];
+    for (int c = 0; c < 3; ++c)
+      if (model_.bc_mask[i] & (1u << c)) {
+        reaction_[b][c] = f_int_[i][c] - f_ext_[i][c];
+        a_[i][c] = 0.0;
+      } else {
+        reaction_[b][c] = 0.0;
+      }
+  }
+}
+
+void Simulation::step() {
+  dt_ = next_dt();
+  const double dt = dt_, half = 0.5 * dt;
+  const Index n = model_.mesh.num_nodes();
+  const Vec3 g = model_.scene.gravity;
+  // External work over the step: gravity exactly (constant force), reactions
+  // by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
+  std::vector<Vec3> dx_bc(bc_nodes_.size());
+  const std::vector<Vec3> reaction_old = reaction_;
+
+  parallel_for_each(n, [&](Index i) {
+    v_[i] += half * a_[i];
+    if (model_.bc_mask[i])
+      for (int c = 0; c < 3; ++c)
+        if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
+  });
+  const double gravity_work = g.squaredNorm() == 0 ? 0.0 : deterministic_sum(n, 0.0, [&](Index i) {
+    return model_.mass[i] * g.dot(dt * v_[i]);
+  });
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) dx_bc[b] = dt * v_[bc_nodes_[b]];
+  parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
+
+  compute_forces();
+
+  parallel_for_each(n, [&](Index i) {
+    v_[i] += half * a_[i];
+    if (model_.bc_mask[i])
+      for (int c = 0; c < 3; ++c)
+        if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
+  });
+  double reaction_work = 0;
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction_work += 0.5 * (reaction_old[b] + reaction_[b]).dot(dx_bc[b]);
+  ledger_.external_work += gravity_work + reaction_work;
+  time_ += dt;
+  ++step_;
+  update_ledger();
+}
+
+void Simulation::update_ledger() {
+  const Index n = model_.mesh.num_nodes();
+  const Momenta m = deterministic_sum(n, Momenta{}, [&](Index i) {
+    Momenta t;
+    const Vec3 p = model_.mass[i] * v_[i];
+    t.kinetic = 0.5 * p.dot(v_[i]);
+    t.p = p;
+    t.L = x_[i].cross(p);
+    return t;
+  });
+  ledger_.kinetic = m.kinetic;
+  ledger_.momentum = m.p;
+  ledger_.angular_momentum = m.L;
+  ledger_.strain = last_elements_.strain_energy;
+  // Energy errors are relative to the largest energy the model has held.
+  energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
+                                              std::abs(ledger_.external_work));
+}
+
+void Simulation::write_outputs(bool fields) {
+  if (opt_.out_dir.empty()) return;
+  const Ledger& l = ledger_;
+  *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
+            << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
+            << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
+            << l.contacts << l.cohesive_elements << l.fragments;
+  history_->end_row();
+
+  const Mesh& mesh = model_.mesh;
+  const int nb = static_cast<int>(model_.scene.bodies.size());
+  std::vector<BodyRow> rows(nb);
+  for (Index i = 0; i < mesh.num_nodes(); ++i) {
+    BodyRow& r = rows[mesh.node_body[i]];
+    r.mass += model_.mass[i];
+    r.mx += model_.mass[i] * x_[i];
+    r.mv += model_.mass[i] * v_[i];
+  }
+  for (int b = 0; b < nb; ++b) {
+    const Vec3 c = rows[b].mx / rows[b].mass, v = rows[b].mv / rows[b].mass;
+    *bodies_ << step_ << time_ << model_.scene.bodies[b].name << rows[b].mass << c.x() << c.y() << c.z() << v.x()
+             << v.y() << v.z();
+    bodies_->end_row();
+  }
+
+  if (fields && fields_) {
+    std::vector<Vec3> u(mesh.num_nodes());
+    for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] = x_[i] - mesh.reference[i];
+    std::vector<double> stress, vm;
+    element_stresses(model_, x_, stress, vm);
+    FieldFrame f;
+    f.step = static_cast<int>(step_);
+    f.time = time_;
+    f.displacement = u;
+    f.velocity = v_;
+    f.stress = stress;
+    f.von_mises = vm;
+    f.body = mesh.elem_body;
+    fields_->write(mesh, f);
+  }
+}
+
+long Simulation::run() {
+  const Scene& scene = model_.scene;
+  const auto wall0 = std::chrono::steady_clock::now();
+  long field_every = scene.output_every;
+  if (field_every < 0) {
+    // Default: about 20 frames over the run.
+    const double est_steps = scene.end_time / (scene.fixed_dt ? *scene.fixed_dt : stable_dt());
+    field_every = std::max(1L, static_cast<long>(std::ceil(est_steps / 20)));
+  }
+  if (!opt_.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(opt_.out_dir, ec);
+    if (ec) throw Error("cannot create the output folder " + opt_.out_dir.string() + ": " + ec.message());
+    history_ = std::make_unique<CsvWriter>(
+        opt_.out_dir / "history.csv",
+        std::vector<std::string>{"step", "time", "dt", "kinetic", "strain", "cohesive_stored", "cohesive_dissipated",
+                                 "contact_dissipated", "external_work", "total", "px", "py", "pz", "Lx", "Ly", "Lz",
+                                 "contacts", "cohesive_elements", "fragments"});
+    bodies_ = std::make_unique<CsvWriter>(
+        opt_.out_dir / "bodies.csv",
+        std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"});
+    if (field_every > 0) fields_ = std::make_unique<FieldWriter>(opt_.out_dir, MPI_COMM_WORLD);
+  }
+  Progress progress(scene.end_time, opt_.quiet);
+  write_outputs(field_every > 0);
+  const double tiny = 1e-12 * scene.end_time;
+  while (time_ < scene.end_time - tiny) {
+    step();
+    const bool last = time_ >= scene.end_time - tiny;
+    const bool field_row = field_every > 0 && (step_ % field_every == 0 || last);
+    if (step_ % scene.history_every == 0 || last || field_row) write_outputs(field_row);
+    progress.update(step_, time_, dt_, energy_error(), last);
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  fields_.reset();
+  if (!opt_.out_dir.empty()) write_summary(wall);
+  return step_;
+}
+
+void Simulation::write_summary(double wall) {
+  const Ledger& l = ledger_;
+  JsonObject j;
+  j.add("name", model_.scene.name);
+  j.add("scene", model_.scene.file);
+  j.add("ranks", opt_.ranks);
+  j.add("threads", opt_.threads);
+  j.add("deterministic", std::string(opt_.deterministic ? "true" : "false"));
+  j.add("steps", step_);
+  j.add("end_time", time_);
+  j.add("wall_time", wall);
+  j.add("time_per_step", step_ > 0 ? wall / step_ : 0.0);
+  j.add("element_loop_time", element_seconds_);
+  // element-steps per second per core spent in the element loop
+  j.add("element_updates_per_second",
+        element_seconds_ > 0 ? double(model_.mesh.num_elements()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
+  j.add("peak_memory_bytes", peak_memory_bytes());
+  j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
+  j.add("elements", static_cast<long>(model_.mesh.num_elements()));
+  j.add("element_order", model_.mesh.order);
+  j.add("bodies", static_cast<long>(model_.scene.bodies.size()));
+  j.add("kinetic", l.kinetic);
+  j.add("strain", l.strain);
+  j.add("cohesive_stored", l.cohesive_stored);
+  j.add("cohesive_dissipated", l.cohesive_dissipated);
+  j.add("contact_dissipated", l.contact_dissipated);
+  j.add("external_work", l.external_work);
+  j.add("total", l.total());
+  j.add("initial_total", total0_);
+  j.add("energy_error", energy_error());
+  j.add("contacts", l.contacts);
+  j.add("cohesive_elements", l.cohesive_elements);
+  j.add("fragments", l.fragments);
+  j.write(opt_.out_dir / "summary.json");
+}
+
+}  // namespace shatter

@@ -1,0 +1,95 @@
+#pragma once
+// The time loop (DESIGN.md "The physics, one time step"): central difference
+// with lumped mass in velocity-Verlet form, which allows the step to change
+// from one step to the next:
+//   1. v(n+1/2) = v(n) + dt/2 a(n);  x(n+1) = x(n) + dt v(n+1/2)
+//   2. contact (when the scene has a contact block)
+//   3. f_int(x(n+1)) from the elements; f_ext = m g + reactions
+//   4. a(n+1) = M^-1 (f_ext - f_int);  v(n+1) = v(n+1/2) + dt/2 a(n+1)
+//   5. fracture (when a material has a fracture block)
+//   6. ledger, output, progress
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "runtime/element_forces.hpp"
+#include "runtime/model.hpp"
+
+namespace shatter {
+
+class FieldWriter;
+class CsvWriter;
+
+struct RunOptions {
+  std::filesystem::path out_dir;  ///< empty: write no files (tests)
+  int threads = 1;
+  int ranks = 1;
+  bool quiet = false;
+  bool deterministic = false;
+};
+
+/// The energy and momentum ledger of SCENE.md (history.csv columns), SI units.
+struct Ledger {
+  double kinetic = 0, strain = 0, cohesive_stored = 0, cohesive_dissipated = 0, contact_dissipated = 0,
+         external_work = 0;
+  Vec3 momentum = Vec3::Zero();          ///< kg m/s
+  Vec3 angular_momentum = Vec3::Zero();  ///< about the origin, kg m^2/s
+  long contacts = 0, cohesive_elements = 0, fragments = 0;
+  /// kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work
+  double total() const {
+    return kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work;
+  }
+};
+
+class Simulation {
+ public:
+  Simulation(Model& model, RunOptions options);
+  ~Simulation();
+
+  /// Advance one step.
+  void step();
+  /// Run to scene.end_time with outputs and progress; returns the number of steps.
+  long run();
+
+  const Ledger& ledger() const { return ledger_; }
+  /// (total - initial total) / (largest kinetic + strain + stored + |external work| so far).
+  double energy_error() const { return (ledger_.total() - total0_) / energy_scale_; }
+  double time() const { return time_; }
+  double dt() const { return dt_; }
+  long steps() const { return step_; }
+  /// Stable step of the current configuration times the scene's safety factor, s.
+  double stable_dt() const { return model_.scene.safety * stable_dt_; }
+  std::span<const Vec3> positions() const { return x_; }
+  std::span<const Vec3> velocities() const { return v_; }
+  std::span<const Vec3> internal_forces() const { return f_int_; }
+  const Model& model() const { return model_; }
+  double element_loop_seconds() const { return element_seconds_; }
+
+ private:
+  void compute_forces();
+  void update_ledger();
+  void write_outputs(bool fields);
+  void write_summary(double wall_seconds);
+  double next_dt() const;
+
+  Model& model_;
+  RunOptions opt_;
+  ElementForces elements_;
+  std::vector<Vec3> x_, v_, a_, f_int_, f_ext_;
+  std::vector<double> inv_mass_;
+  std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
+  std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
+  double time_ = 0, dt_ = 0, stable_dt_ = 0;
+  long step_ = 0;
+  Ledger ledger_;
+  ElementLoopResult last_elements_;
+  double element_seconds_ = 0;
+  double total0_ = 0, energy_scale_ = 0;
+  std::unique_ptr<FieldWriter> fields_;
+  std::unique_ptr<CsvWriter> history_, bodies_;
+};
+
+}  // namespace shatter
