@@ -11,6 +11,16 @@
 namespace shatter {
 namespace {
 
+/// Nearest float not above (below) x, so float bounds contain the double box.
+float round_down(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float round_up(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
 double largest_side(const Box& b) { return (b.hi - b.lo).maxCoeff(); }
 
 Box bounding_box(std::span<const Box> boxes) {
@@ -41,12 +51,11 @@ double base_cell_size(std::span<const Box> boxes, const Box& all) {
   double h = 2.0 * *mid;
   if (!(h > 0)) h = span / std::max(1.0, std::cbrt(static_cast<double>(boxes.size())));
   if (!(h > 0)) h = 1.0;
-  // keep cell indices inside 31 bits
-  return std::max(h, span * 0x1p-30);
+  // keep cell indices inside 29 bits
+  return std::max(h, span * 0x1p-28);
 }
 
 struct Entry {
-  int level;
   std::uint64_t key;
   double lo;
   Index box;
@@ -82,10 +91,13 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
         return acc;
       },
       [](int a, int c) { return std::max(a, c); });
-  for (int l = 0; l <= max_level; ++l) b.cell_size.push_back(std::ldexp(h0, 2 * l));
+  for (int l = 0; l <= max_level; ++l) {
+    b.cell_size.push_back(std::ldexp(h0, 2 * l));
+    b.cell_inverse.push_back(1.0 / b.cell_size.back());
+  }
 
   const int u = b.axis[0], v = b.axis[1];
-  auto cell_range = [&](size_t k, std::uint32_t& i0, std::uint32_t& i1, std::uint32_t& j0, std::uint32_t& j1) {
+  auto cell_range = [&](size_t k, std::uint64_t& i0, std::uint64_t& i1, std::uint64_t& j0, std::uint64_t& j1) {
     const int l = level[k];
     i0 = b.cell(0, l, boxes[k].lo[u]);
     i1 = b.cell(0, l, boxes[k].hi[u]);
@@ -97,7 +109,7 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   std::vector<size_t> first(n + 1, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
-      std::uint32_t i0, i1, j0, j1;
+      std::uint64_t i0, i1, j0, j1;
       cell_range(k, i0, i1, j0, j1);
       first[k + 1] = size_t(i1 - i0 + 1) * size_t(j1 - j0 + 1);
     }
@@ -116,25 +128,30 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   const int wa = b.axis[2];
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
-      std::uint32_t i0, i1, j0, j1;
+      std::uint64_t i0, i1, j0, j1;
       cell_range(k, i0, i1, j0, j1);
       size_t p = first[k];
       for (std::uint64_t i = i0; i <= i1; ++i)
         for (std::uint64_t j = j0; j <= j1; ++j)
-          entries[p++] = {level[k], (i << 32) | j, boxes[k].lo[wa], static_cast<Index>(k)};
+          entries[p++] = {SparseBucket::key(level[k], i, j), boxes[k].lo[wa], static_cast<Index>(k)};
     }
   });
   // A total order, so the sorted array is the same for any thread count.
   tbb::parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& c) {
-    return std::tie(a.level, a.key, a.lo, a.box) < std::tie(c.level, c.key, c.lo, c.box);
+    return std::tie(a.key, a.lo, a.box) < std::tie(c.key, c.lo, c.box);
   });
 
   const size_t m = entries.size();
   b.entry_lo.resize(m);
+  b.entry_hi.resize(m);
+  b.entry_uv.resize(m);
   b.entry_box.resize(m);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, m), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
+      const Box& x = boxes[entries[k].box];
       b.entry_lo[k] = entries[k].lo;
+      b.entry_hi[k] = x.hi[wa];
+      b.entry_uv[k] = {round_down(x.lo[u]), round_up(x.hi[u]), round_down(x.lo[v]), round_up(x.hi[v])};
       b.entry_box[k] = entries[k].box;
     }
   });
@@ -143,11 +160,12 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   for (size_t k = 0; k < m;) {
     size_t e = k;
     double extent = 0;
-    for (; e < m && entries[e].level == entries[k].level && entries[e].key == entries[k].key; ++e) {
+    for (; e < m && entries[e].key == entries[k].key; ++e) {
       const Box& x = boxes[entries[e].box];
       extent = std::max(extent, x.hi[wa] - x.lo[wa]);
     }
-    while (static_cast<int>(b.level_cells.size()) <= entries[k].level)
+    const auto level_k = static_cast<int>(entries[k].key >> (2 * SparseBucket::kCellBits));
+    while (static_cast<int>(b.level_cells.size()) <= level_k)
       b.level_cells.push_back(static_cast<Index>(b.cell_key.size()));
     b.cell_key.push_back(entries[k].key);
     b.cell_max_extent.push_back(extent);
@@ -160,10 +178,11 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
 }
 
 std::size_t memory_bytes(const SparseBucket& b) {
-  return sizeof(SparseBucket) + b.cell_size.capacity() * sizeof(double) +
+  return sizeof(SparseBucket) + (b.cell_size.capacity() + b.cell_inverse.capacity()) * sizeof(double) +
          b.level_cells.capacity() * sizeof(Index) + b.cell_key.capacity() * sizeof(std::uint64_t) +
          b.cell_entries.capacity() * sizeof(Index) + b.cell_max_extent.capacity() * sizeof(double) +
-         b.entry_lo.capacity() * sizeof(double) + b.entry_box.capacity() * sizeof(Index);
+         (b.entry_lo.capacity() + b.entry_hi.capacity()) * sizeof(double) +
+         b.entry_uv.capacity() * sizeof(std::array<float, 4>) + b.entry_box.capacity() * sizeof(Index);
 }
 
 }  // namespace shatter

@@ -41,30 +41,43 @@ inline bool boxes_overlap(const Box& a, const Box& b) {
 ///   axis = {u, v, w}                w = the axis along which all boxes spread most
 ///   origin[2]                       lowest lo along u and v
 ///   cell_size[L]                    h_l = h_0 4^l; h_0 = 2 x the median largest box side
+///   cell_inverse[L]                 1 / h_l
 ///   level_cells[L+1]                cells of level l: [level_cells[l], level_cells[l+1])
-///   cell_key[C]                     (i << 32) | j, i = floor((x_u - origin_u) / h_l),
-///                                   ascending within a level
+///   cell_key[C]                     (l << 58) | (i << 29) | j, ascending, with cell indices
+///                                   i = floor((x_u - origin_u) / h_l), j likewise along v
 ///   cell_entries[C+1]               entries of cell c: [cell_entries[c], cell_entries[c+1])
 ///   cell_max_extent[C]              max over the cell's boxes of hi_w - lo_w
 ///   entry_lo[N]                     lo_w of the box, ascending within a cell (ties by id)
+///   entry_hi[N]                     hi_w of the box
+///   entry_uv[N]                     {lo_u, hi_u, lo_v, hi_v} of the box in float, rounded
+///                                   outward: a cache-friendly filter before the exact test
 ///   entry_box[N]                    box id
 struct SparseBucket {
   std::array<int, 3> axis = {0, 1, 2};
   std::array<double, 2> origin = {0, 0};
   std::vector<double> cell_size;
+  std::vector<double> cell_inverse;
   std::vector<Index> level_cells = {0};
   std::vector<std::uint64_t> cell_key;
   std::vector<Index> cell_entries = {0};
   std::vector<double> cell_max_extent;
   std::vector<double> entry_lo;
+  std::vector<double> entry_hi;
+  std::vector<std::array<float, 4>> entry_uv;
   std::vector<Index> entry_box;
 
   int num_levels() const { return static_cast<int>(cell_size.size()); }
-  /// Bucket index of coordinate x along grid axis k (0 = u, 1 = v) on level l;
-  /// monotone in x, so a box's cells are [cell(lo), cell(hi)].
-  std::uint32_t cell(int k, int l, double x) const {
-    const double s = std::floor((x - origin[k]) / cell_size[l]);
-    return static_cast<std::uint32_t>(std::clamp(s, 0.0, 2147483647.0));
+  static constexpr int kCellBits = 29;
+  static constexpr std::uint64_t kCellMask = (std::uint64_t(1) << kCellBits) - 1;
+
+  /// Bucket index of coordinate x along grid axis k (0 = u, 1 = v) on level l,
+  /// in [0, 2^29); monotone in x, so a box's cells are [cell(lo), cell(hi)].
+  std::uint64_t cell(int k, int l, double x) const {
+    const double s = std::floor((x - origin[k]) * cell_inverse[l]);
+    return static_cast<std::uint64_t>(std::clamp(s, 0.0, double(kCellMask)));
+  }
+  static std::uint64_t key(int l, std::uint64_t i, std::uint64_t j) {
+    return (std::uint64_t(l) << (2 * kCellBits)) | (i << kCellBits) | j;
   }
 };
 
@@ -87,16 +100,17 @@ void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, cons
     const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
     const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
     // Walk only the non-empty cells of rows i0..i1, jumping over gaps by bisection.
-    auto it = std::lower_bound(first, last, (i0 << 32) | j0);
+    auto it = std::lower_bound(first, last, SparseBucket::key(l, i0, j0));
     while (it != last) {
-      const std::uint64_t i = *it >> 32, j = *it & 0xffffffffu;
+      const std::uint64_t i = (*it >> SparseBucket::kCellBits) & SparseBucket::kCellMask;
+      const std::uint64_t j = *it & SparseBucket::kCellMask;
       if (i > i1) break;
       if (j < j0) {
-        it = std::lower_bound(it, last, (i << 32) | j0);
+        it = std::lower_bound(it, last, SparseBucket::key(l, i, j0));
         continue;
       }
       if (j > j1) {
-        it = std::lower_bound(it, last, ((i + 1) << 32) | j0);
+        it = std::lower_bound(it, last, SparseBucket::key(l, i + 1, j0));
         continue;
       }
       const auto c = static_cast<Index>(it - b.cell_key.begin());
@@ -104,10 +118,16 @@ void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, cons
       // the bisection conservative under rounding, the exact test decides.
       const double m = b.cell_max_extent[c];
       const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m);
-      const auto e_first = b.entry_lo.begin() + b.cell_entries[c];
-      const auto e_last = b.entry_lo.begin() + b.cell_entries[c + 1];
-      for (auto e = std::lower_bound(e_first, e_last, w_from); e != e_last && *e <= q.hi[w]; ++e) {
-        const Index id = b.entry_box[e - b.entry_lo.begin()];
+      const auto lo_first = b.entry_lo.begin() + b.cell_entries[c];
+      const auto lo_last = b.entry_lo.begin() + b.cell_entries[c + 1];
+      const auto e_end = static_cast<size_t>(b.cell_entries[c + 1]);
+      for (auto e = static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
+           e != e_end && b.entry_lo[e] <= q.hi[w]; ++e) {
+        // float bounds are rounded outward, so this filter never drops an overlap
+        const auto& uv = b.entry_uv[e];
+        if (b.entry_hi[e] < q.lo[w] || uv[0] > q.hi[u] || uv[1] < q.lo[u] || uv[2] > q.hi[v] || uv[3] < q.lo[v])
+          continue;
+        const Index id = b.entry_box[e];
         const Box& x = boxes[id];
         if (!boxes_overlap(q, x)) continue;
         if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i && b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
