@@ -99,7 +99,9 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
     const Index last = std::min(nc, first + kBlock);
     tbb::parallel_for(tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
       for (Index c = r.begin(); c != r.end(); ++c) {
-        const CohesiveLaw& law = *facet_law(mesh, topo, laws, coh.facet[c]);
+        const CohesiveLaw* law_ptr = facet_law(mesh, topo, laws, coh.facet[c]);
+        SHATTER_ASSERT(law_ptr);  // insertion happens only where the criterion has a law
+        const CohesiveLaw& law = *law_ptr;
         const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
         const Index* side1 = side0 + kSlots;
         // Mid-surface normal from the corners, pointing from side 0 to side 1.

@@ -53,7 +53,8 @@ struct Insertion {
   Index first_cohesive = 0;
 };
 
-/// Insert cohesive elements on the given intact interior facets (extrinsic:
+/// Insert cohesive elements on the given intact interior facets, which must
+/// have a law (facet_law; critical_facets returns only such facets) (extrinsic:
 /// delta_max = 0, traction sigma_c at first opening). The facets are processed
 /// in canonical order (sorted by Topology::facet_gid) whatever their order in
 /// `facets`, so the result does not depend on how they were found. Marks the

@@ -1,8 +1,10 @@
 // Determinism: the facet check and the cohesive forces give identical results
 // for 1, 2 and 4 threads.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -12,6 +14,8 @@
 using namespace shatter;
 
 TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
+  // Allow 4 threads even on a smaller machine (oversubscription is fine here).
+  tbb::global_control allow(tbb::global_control::max_allowed_parallelism, 4);
   Mesh m = test::box_mesh(0.1, 1);
   Topology t = build_topology(m);
   const CohesiveLaw law = make_cohesive_law(1.0e6, 50.0, 0.8, 1.0e12);
@@ -36,6 +40,19 @@ TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
       EXPECT_GT(facets.size(), 50u);
       EXPECT_LT(facets.size(), static_cast<size_t>(t.num_facets()));
       for (size_t i = 1; i < facets.size(); ++i) EXPECT_LT(t.facet_gid[facets[i - 1]], t.facet_gid[facets[i]]);
+      // The same set as a direct serial evaluation of the criterion.
+      std::vector<GlobalId> direct, found;
+      for (Index f = 0; f < t.num_facets(); ++f) {
+        if (!t.is_interior(f)) continue;
+        const auto [e0, e1] = t.facet_elem[f];
+        const auto fn = face_nodes(m, e0, t.facet_face[f][0]);
+        const Vec3 n = (m.reference[fn[1]] - m.reference[fn[0]]).cross(m.reference[fn[2]] - m.reference[fn[0]]).normalized();
+        const Mat3 sigma = 0.5 * (element_cauchy_stress(stress, 6, e0) + element_cauchy_stress(stress, 6, e1));
+        if (facet_effective_traction(sigma, n, law.beta) >= law.sigma_c) direct.push_back(t.facet_gid[f]);
+      }
+      for (const Index f : facets) found.push_back(t.facet_gid[f]);
+      std::sort(direct.begin(), direct.end());
+      EXPECT_EQ(found, direct);
     } else {
       EXPECT_EQ(facets, reference_facets) << threads << " threads";
     }
