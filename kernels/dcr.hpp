@@ -52,8 +52,9 @@ struct DcrLaw {
                              ///< pair's longest edge (dimensionless)
 };
 
-/// |g| below kDcrVolumeTolerance L^3 (L the pair's longest edge) counts as touching.
-inline constexpr double kDcrVolumeTolerance = 1e-10;
+/// A distance below kDcrTouchTolerance L (L the pair's longest edge) counts as touching:
+/// |g| <= kDcrTouchTolerance L |n| / 6, with |n| from pair_normal_norm.
+inline constexpr double kDcrTouchTolerance = 1e-11;
 /// Barycentric / segment-parameter slack of the inside tests (dimensionless), so a
 /// vertex crossing exactly on an edge shared by two triangles is caught by both.
 inline constexpr double kDcrInsideTolerance = 1e-9;
@@ -94,14 +95,20 @@ inline double pair_normal_norm(DcrPairKind kind, const PairPoints& X) {
   return (X.col(1) - X.col(0)).cross(X.col(3) - X.col(2)).norm();
 }
 
+/// The touching tolerance on |g| over a step (m^3): kDcrTouchTolerance L |n| / 6 with L
+/// from X_old and the larger |n| of X_old and X_new.
+inline double dcr_touch_tolerance(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
+  return kDcrTouchTolerance * pair_length_scale(kind, X_old) *
+         std::max(pair_normal_norm(kind, X_old), pair_normal_norm(kind, X_new)) / 6.0;
+}
+
 /// Orientation s of the constraint g = s V: -1 for a vertex and a face; for two
 /// edges the sign of V at the start of the step, or, when they start touching,
 /// the side they came from: -sign(V(X_new)) (so moving through counts as penetration).
 inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
   if (kind == DcrPairKind::VertexFace) return -1.0;
-  const double L = pair_length_scale(kind, X_old);
   const double V0 = pair_volume(X_old);
-  if (std::abs(V0) > kDcrVolumeTolerance * L * L * L) return V0 > 0 ? 1.0 : -1.0;
+  if (std::abs(V0) > dcr_touch_tolerance(kind, X_old, X_new)) return V0 > 0 ? 1.0 : -1.0;
   return pair_volume(X_new) > 0 ? -1.0 : 1.0;
 }
 
@@ -175,13 +182,12 @@ struct DcrPenetration {
 /// Robust for fast motion (exact cubic in t, no sampling), grazing (g touches 0 and
 /// returns: g(X_new) > -tol), touching at the end (|g| <= tol) and degenerate
 /// geometry (zero-area triangles and parallel edges are left to neighbouring pairs).
-/// tol = kDcrVolumeTolerance L^3, L from pair_length_scale(X_old).
+/// tol = dcr_touch_tolerance(kind, X_old, X_new).
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
   DcrPenetration out;
   out.orientation = dcr_orientation(kind, X_old, X_new);
   const double s = out.orientation;
-  const double L = pair_length_scale(kind, X_old);
-  const double tol = kDcrVolumeTolerance * L * L * L;
+  const double tol = dcr_touch_tolerance(kind, X_old, X_new);
   if (!(s * pair_volume(X_new) < -tol)) return out;
 
   DcrCubic g = pair_volume_along(X_old, X_new - X_old);
@@ -223,28 +229,31 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 }
 
 /// Removes the penetration of a pair in place by the mass-weighted projection
-///   x_i <- x_i + mu W_i grad_i g(X),  mu > 0,
+///   x_i <- x_i + mu W_i grad_i g(X_contact),  mu > 0,
 /// with g(mu) = g_target = gap L |n| / 6 (a separation of gap L, L and |n| from
 /// pair_length_scale and pair_normal_norm at X): the smallest positive root of this
-/// cubic in mu. The direction is M^-1 grad g, so sum_i m_i dx_i = 0 (the pair's centre of
-/// mass does not move) and nodes with W_i = 0 stay put ([CW] sec. 4, closest-point
-/// projection in the mass metric). When the cubic has no root in reach, the step goes to
-/// its maximum and the gradient is re-evaluated (at most 4 passes).
+/// cubic in mu. X_contact is the configuration at the contact time t* (g = 0): there the
+/// gradient is the contact normal weighted by the closest-point coordinates (vertex and
+/// barycentric point of the face / the crossing points of the edges), the closest-point
+/// projection of [CW]; the gradient at the penetrated X would also carry terms of the
+/// order of depth x edge length that tilt nearly parallel edges instead of separating
+/// them. The direction is M^-1 grad g, so sum_i m_i dx_i = 0 (the pair's centre of mass
+/// does not move) and nodes with W_i = 0 stay put. When the cubic has no root in reach,
+/// the step goes to its maximum and the gradient is re-evaluated at X (at most 4 passes).
 /// Returns whether g(X) > 0 afterwards (false e.g. when all four nodes are fixed).
-inline bool dcr_project(DcrPairKind kind, double orientation, PairPoints& X, const PairWeights& inv_mass,
-                        double gap) {
+inline bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
+                        const PairWeights& inv_mass, double gap) {
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
-    const PairPoints G = s * pair_volume_gradient(X);
+    const PairPoints G = s * pair_volume_gradient(pass == 0 ? X_contact : X);
     PairPoints D = G;
     for (int i = 0; i < 4; ++i) D.col(i) *= inv_mass[i];
-    const double q = (G.array() * D.array()).sum();
-    if (!(q > 0.0)) return false;
     DcrCubic g = pair_volume_along(X, D);
     g = {s * g.c0 - target, s * g.c1, s * g.c2, s * g.c3};
     if (g.c0 >= 0.0) return true;
-    const double hi = 16.0 * (-g.c0 / q);
+    if (!(g.c1 > 0.0)) continue;  // not a separating direction at X (or all nodes fixed)
+    const double hi = 16.0 * (-g.c0 / g.c1);
     std::array<double, 4> br;
     const int n = dcr_monotone_breaks(g, 0.0, hi, br);
     double mu = 0.0;
@@ -365,15 +374,17 @@ struct DcrPairResponse {
 };
 
 /// One DCR resolution of a pair over a step: detect (dcr_detect on X_old -> X_new); if it
-/// penetrates, project X_new (dcr_project) and update the velocities V at the projected
-/// positions (dcr_impulse). X_new and V are updated in place.
+/// penetrates, project X_new (dcr_project, direction from the configuration at t*) and
+/// update the velocities V at the projected positions (dcr_impulse). X_new and V are
+/// updated in place.
 inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new,
                                         PairPoints& V, const PairWeights& inv_mass, const DcrLaw& law) {
   DcrPairResponse out;
   const DcrPenetration pen = dcr_detect(kind, X_old, X_new);
   if (!pen.penetrating) return out;
   out.active = true;
-  out.separated = dcr_project(kind, pen.orientation, X_new, inv_mass, law.gap);
+  const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
+  out.separated = dcr_project(kind, pen.orientation, X_contact, X_new, inv_mass, law.gap);
   out.impulse = dcr_impulse(kind, pen.orientation, X_new, V, inv_mass, law);
   return out;
 }

@@ -216,7 +216,7 @@ TEST(DcrDetect, ParallelEdgesAreLeftToTheVertexFacePairs) {
   const PairPoints Xo = points(Vec3(-1, 0, 0.1), Vec3(1, 0, 0.1), Vec3(-1, 0.5, 0), Vec3(1, 0.5, 0));
   const PairPoints Xn = points(Vec3(-1, 1, -0.1), Vec3(1, 1, -0.1), Vec3(-1, 0.5, 0), Vec3(1, 0.5, 0));
   EXPECT_FALSE(dcr_detect(EE, Xo, Xn).penetrating);
-  // Nearly parallel (1e-8 rad) and crossing: the volume stays below the touching tolerance.
+  // Nearly parallel (1e-8 rad) and crossing: below the parallel tolerance.
   PairPoints Yn = Xn;
   Yn.col(1).y() += 2e-8;
   EXPECT_FALSE(dcr_detect(EE, Xo, Yn).penetrating);
@@ -242,7 +242,8 @@ TEST(DcrProject, RemovesPenetrationKeepsCentreOfMassAndFixedNodes) {
     PairWeights w = random_inv_mass(rng);
     if (trial % 3 == 0) w[1] = 0;  // a fixed node
     PairPoints X = Xn;
-    ASSERT_TRUE(dcr_project(kind, pen.orientation, X, w, 1e-6));
+    const PairPoints Xc = Xo + pen.time * (Xn - Xo);
+    ASSERT_TRUE(dcr_project(kind, pen.orientation, Xc, X, w, 1e-6));
     const double target = 1e-6 * pair_length_scale(kind, Xn) * pair_normal_norm(kind, Xn) / 6;
     EXPECT_GT(pen.orientation * pair_volume(X), 0.0);
     EXPECT_CLOSE(pen.orientation * pair_volume(X), target, 1e-6, 0);
@@ -264,7 +265,7 @@ TEST(DcrProject, RemovesPenetrationKeepsCentreOfMassAndFixedNodes) {
 TEST(DcrProject, AllNodesFixedCannotBeResolved) {
   PairPoints X = points(Vec3(0.2, 0.2, -0.1), kA, kB, kC);
   const PairPoints X0 = X;
-  EXPECT_FALSE(dcr_project(VF, -1.0, X, PairWeights::Zero(), 1e-6));
+  EXPECT_FALSE(dcr_project(VF, -1.0, X, X, PairWeights::Zero(), 1e-6));
   EXPECT_EQ(X, X0);
 }
 

@@ -1,0 +1,100 @@
+#include "contact/dcr.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cstdint>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+
+void contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, std::vector<Index>& nodes) {
+  offsets.resize(pairs.size() + 1);
+  nodes.resize(4 * pairs.size());
+  for (size_t i = 0; i <= pairs.size(); ++i) offsets[i] = static_cast<Index>(4 * i);
+  for (size_t i = 0; i < pairs.size(); ++i)
+    for (int k = 0; k < 4; ++k) nodes[4 * i + k] = pairs[i].nodes[k];
+}
+
+namespace {
+
+bool distinct_nodes(const ContactPair& p) {
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      if (p.nodes[i] == p.nodes[j]) return false;
+  return true;
+}
+
+}  // namespace
+
+DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std::span<const Vec3> x_old,
+                           std::span<Vec3> v, std::span<const double> inv_mass, const DcrOptions& options,
+                           const DcrPairColors& colors) {
+  const size_t n_nodes = x_new.size();
+  SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
+                  "resolve_contacts: nodal arrays differ in size (x_new " << n_nodes << ", x_old " << x_old.size()
+                                                                          << ", v " << v.size() << ", inv_mass "
+                                                                          << inv_mass.size() << ")");
+  SHATTER_REQUIRE(colors.items.size() == pairs.size() && !colors.offsets.empty() &&
+                      colors.offsets.back() == static_cast<Index>(pairs.size()),
+                  "resolve_contacts: the coloring covers " << colors.items.size() << " items, not the "
+                                                           << pairs.size() << " pairs");
+  SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
+  const DcrLaw law{options.restitution, options.friction, options.gap};
+
+  // Per-pair accumulators, summed in pair order at the end: the totals do not depend on
+  // which thread ran which pair.
+  std::vector<double> dissipated(pairs.size(), 0.0);
+  std::vector<std::uint8_t> ever_active(pairs.size(), 0);
+  std::vector<std::uint8_t> active_now(pairs.size(), 0);
+
+  auto resolve = [&](Index i) {
+    const ContactPair& pair = pairs[i];
+    active_now[i] = 0;
+    if (!distinct_nodes(pair)) return;
+    PairPoints X_old, X_new, V;
+    PairWeights w;
+    for (int k = 0; k < 4; ++k) {
+      const Index n = pair.nodes[k];
+      X_old.col(k) = x_old[n];
+      X_new.col(k) = x_new[n];
+      V.col(k) = v[n];
+      w[k] = inv_mass[n];
+    }
+    const auto kind = pair.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
+    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law);
+    if (!r.active) return;
+    active_now[i] = 1;
+    ever_active[i] = 1;
+    dissipated[i] += r.impulse.dissipated;
+    for (int k = 0; k < 4; ++k) {
+      const Index n = pair.nodes[k];
+      x_new[n] = X_new.col(k);
+      v[n] = V.col(k);
+    }
+  };
+
+  DcrResult result;
+  bool converged = false;
+  while (result.sweeps < options.max_sweeps && !converged) {
+    ++result.sweeps;
+    for (size_t c = 0; c + 1 < colors.offsets.size(); ++c) {
+      const auto group = colors.items.subspan(colors.offsets[c], colors.offsets[c + 1] - colors.offsets[c]);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) resolve(group[k]);
+      });
+    }
+    converged = true;
+    for (const std::uint8_t a : active_now)
+      if (a) converged = false;
+  }
+  result.capped = !converged;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    result.contacts += ever_active[i];
+    result.dissipated += dissipated[i];
+  }
+  return result;
+}
+
+}  // namespace shatter

@@ -1,0 +1,351 @@
+// DCR sweeps (contact/dcr.hpp) on small stacks of sheets: every penetration is
+// removed (checked by an independent height-field test, not by the DCR kernels),
+// fixed nodes stay, momentum and energy are accounted for, and the result is
+// bitwise identical for 1, 2 and 4 threads.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cstring>
+#include <iomanip>
+#include <sstream>
+#include <random>
+
+#include "contact/dcr.hpp"
+#include "expect_close.hpp"
+#include "runtime/coloring.hpp"
+
+using namespace shatter;
+
+namespace {
+
+struct Sheet {
+  std::vector<std::array<Index, 3>> triangles;  // counter-clockwise seen from outside
+  std::vector<std::array<Index, 2>> edges;      // e0 < e1
+  std::vector<Index> vertices;
+};
+
+// Stacked bodies, each a bottom sheet (outside = -z) and a top sheet (outside = +z); body 0
+// has only a top sheet. Gaps of 0.2 between bodies at the start; body k moves down by
+// 0.3 k over the step, so neighbouring bodies overlap by about 0.1 at its end.
+struct Stack {
+  std::vector<Vec3> x_old, x_new, v;
+  std::vector<double> inv_mass;
+  std::vector<std::pair<Sheet, Sheet>> contacts;  // (lower top sheet, upper bottom sheet)
+  ContactPairs pairs;
+};
+
+Sheet make_sheet(Stack& s, int n, Vec3 origin, bool outside_up, const Vec3& velocity, double inv_mass_scale,
+                 std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1), m(1, 2);
+  Sheet sheet;
+  const Index first = static_cast<Index>(s.x_old.size());
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const Vec3 x = origin + Vec3(i + 0.05 * u(rng), j + 0.05 * u(rng), 0.02 * u(rng));
+      const Vec3 vel = velocity + 0.05 * Vec3(u(rng), u(rng), u(rng));
+      sheet.vertices.push_back(static_cast<Index>(s.x_old.size()));
+      s.x_old.push_back(x);
+      s.x_new.push_back(x + vel);  // dt = 1 s
+      s.v.push_back(vel);
+      s.inv_mass.push_back(inv_mass_scale / m(rng));
+    }
+  auto id = [&](int i, int j) { return first + j * (n + 1) + i; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      std::array<Index, 3> t0{id(i, j), id(i + 1, j), id(i + 1, j + 1)}, t1{id(i, j), id(i + 1, j + 1), id(i, j + 1)};
+      if (!outside_up) std::swap(t0[1], t0[2]), std::swap(t1[1], t1[2]);
+      sheet.triangles.push_back(t0);
+      sheet.triangles.push_back(t1);
+    }
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      if (i < n) sheet.edges.push_back({id(i, j), id(i + 1, j)});
+      if (j < n) sheet.edges.push_back({id(i, j), id(i, j + 1)});
+      if (i < n && j < n) sheet.edges.push_back({id(i, j), id(i + 1, j + 1)});
+    }
+  return sheet;
+}
+
+struct XyBox {
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
+  void add(const Vec3& x) {
+    lo = lo.cwiseMin(x.head<2>());
+    hi = hi.cwiseMax(x.head<2>());
+  }
+  bool overlaps(const XyBox& o, double pad) const {
+    return (lo.array() - pad <= o.hi.array()).all() && (o.lo.array() - pad <= hi.array()).all();
+  }
+};
+
+template <class Nodes>
+XyBox swept_box(const Stack& s, const Nodes& nodes) {
+  XyBox b;
+  for (const Index n : nodes) b.add(s.x_old[n]), b.add(s.x_new[n]);
+  return b;
+}
+
+// Candidate pairs between the facing sheets of neighbouring bodies: every vertex-face and
+// edge-edge pair whose swept xy boxes overlap (a brute-force broad phase), canonical order.
+void add_candidates(Stack& s, const Sheet& lower, const Sheet& upper) {
+  const double pad = 0.5;  // room for the projections of a collapsing stack
+  auto vf = [&](const Sheet& verts, const Sheet& faces) {
+    for (const Index p : verts.vertices)
+      for (const auto& t : faces.triangles)
+        if (swept_box(s, std::array{p}).overlaps(swept_box(s, t), pad))
+          s.pairs.push_back({ContactPair::VertexFace, {p, t[0], t[1], t[2]}});
+  };
+  vf(upper, lower);
+  vf(lower, upper);
+  for (const auto& e : lower.edges)
+    for (const auto& f : upper.edges)
+      if (swept_box(s, e).overlaps(swept_box(s, f), pad)) {
+        const bool e_first = e < f;
+        const auto& a = e_first ? e : f;
+        const auto& b = e_first ? f : e;
+        s.pairs.push_back({ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}});
+      }
+}
+
+Sheet flipped(Sheet sheet) {
+  for (auto& t : sheet.triangles) std::swap(t[1], t[2]);
+  return sheet;
+}
+
+// thick: body k = separate bottom and top sheets (each vertex in contact with one
+// neighbour); thin: body k = one two-sided sheet at z = 0.2 k moving down by 0.25 k,
+// touching both neighbours, so resolving one contact can push a vertex into the next:
+// the stack collapses into a pile on the ground and Gauss-Seidel needs many sweeps.
+Stack make_stack(int bodies, int n, bool fixed_ground, std::uint64_t seed, bool thin = false) {
+  std::mt19937_64 rng(seed);
+  Stack s;
+  Sheet below = make_sheet(s, n, Vec3(0, 0, 0.8 * !thin), true, Vec3::Zero(), fixed_ground ? 0.0 : 1.0, rng);
+  for (int k = 1; k < bodies; ++k) {
+    const Vec3 velocity(0.03 * k, -0.02 * k, (thin ? -0.25 : -0.3) * k);
+    const Vec3 shift(0.37 * k - std::floor(0.37 * k), 0.23 * k - std::floor(0.23 * k), 0);
+    if (thin) {
+      const Sheet sheet = make_sheet(s, n, Vec3(0, 0, 0.2 * k) + shift, true, velocity, 1.0, rng);
+      add_candidates(s, below, flipped(sheet));
+      s.contacts.emplace_back(below, sheet);
+      below = sheet;
+      continue;
+    }
+    const Sheet bottom = make_sheet(s, n, Vec3(0, 0, k) + shift, false, velocity, 1.0, rng);
+    const Sheet top = make_sheet(s, n, Vec3(0.5, 0.5, k + 0.8) - shift, true, velocity, 1.0, rng);
+    add_candidates(s, below, bottom);
+    s.contacts.emplace_back(below, bottom);
+    below = top;
+  }
+  std::sort(s.pairs.begin(), s.pairs.end());
+  s.pairs.erase(std::unique(s.pairs.begin(), s.pairs.end()), s.pairs.end());
+  return s;
+}
+
+std::string sci(double x) {
+  std::ostringstream os;
+  os << std::scientific << std::setprecision(2) << x;
+  return os.str();
+}
+
+// --- the independent checker: sheets are height fields over xy -------------------------
+
+// Height of triangle t at xy point q, if q projects inside it.
+std::optional<double> height_in(const std::vector<Vec3>& x, const std::array<Index, 3>& t, const Eigen::Vector2d& q) {
+  const Eigen::Vector2d a = x[t[0]].head<2>(), b = x[t[1]].head<2>(), c = x[t[2]].head<2>();
+  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  const double l1 = ((q - a).x() * (c - a).y() - (q - a).y() * (c - a).x()) / det;
+  const double l2 = ((b - a).x() * (q - a).y() - (b - a).y() * (q - a).x()) / det;
+  const double l0 = 1 - l1 - l2;
+  if (l0 < 0 || l1 < 0 || l2 < 0) return std::nullopt;
+  return l0 * x[t[0]].z() + l1 * x[t[1]].z() + l2 * x[t[2]].z();
+}
+
+// Number of places where the upper sheet dips below the lower one: vertices of either
+// sheet against the other sheet's faces, and crossings of edges seen from above.
+int count_penetrations(const std::vector<Vec3>& x, const Sheet& lower, const Sheet& upper) {
+  const double tol = 1e-10;  // DCR treats distances below 1e-11 x edge length as touching
+  int bad = 0;
+  for (const Index p : upper.vertices)
+    for (const auto& t : lower.triangles)
+      if (const auto h = height_in(x, t, x[p].head<2>()); h && x[p].z() < *h - tol) ++bad;
+  for (const Index p : lower.vertices)
+    for (const auto& t : upper.triangles)
+      if (const auto h = height_in(x, t, x[p].head<2>()); h && x[p].z() > *h + tol) ++bad;
+  for (const auto& e : lower.edges)
+    for (const auto& f : upper.edges) {
+      const Eigen::Vector2d p = x[e[0]].head<2>(), r = x[e[1]].head<2>() - p;
+      const Eigen::Vector2d q = x[f[0]].head<2>(), d = x[f[1]].head<2>() - q;
+      const double den = r.x() * d.y() - r.y() * d.x();
+      if (std::abs(den) < 1e-12) continue;
+      const double s = ((q - p).x() * d.y() - (q - p).y() * d.x()) / den;
+      const double u = ((q - p).x() * r.y() - (q - p).y() * r.x()) / den;
+      if (s < 0 || s > 1 || u < 0 || u > 1) continue;
+      const double z_lower = (1 - s) * x[e[0]].z() + s * x[e[1]].z();
+      const double z_upper = (1 - u) * x[f[0]].z() + u * x[f[1]].z();
+      if (z_upper < z_lower - tol) ++bad;
+    }
+  return bad;
+}
+
+int count_penetrations(const Stack& s, const std::vector<Vec3>& x) {
+  int bad = 0;
+  for (const auto& [lower, upper] : s.contacts) bad += count_penetrations(x, lower, upper);
+  return bad;
+}
+
+Coloring color_pairs(const Stack& s) {
+  std::vector<Index> offsets, nodes;
+  contact_pair_nodes(s.pairs, offsets, nodes);
+  return greedy_coloring(offsets, nodes, static_cast<Index>(s.x_old.size()));
+}
+
+DcrResult run(Stack& s, const DcrOptions& options, const Coloring& c) {
+  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, options, {c.offsets, c.items});
+}
+
+struct Totals {
+  Vec3 p = Vec3::Zero(), L = Vec3::Zero();
+  double kinetic = 0, p_scale = 0, L_scale = 0;
+};
+
+Totals totals(const Stack& s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
+  Totals t;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (s.inv_mass[i] == 0) continue;
+    const double m = 1 / s.inv_mass[i];
+    t.p += m * v[i];
+    t.L += m * x[i].cross(v[i]);
+    t.kinetic += 0.5 * m * v[i].squaredNorm();
+    t.p_scale += m * v[i].norm();
+    t.L_scale += m * x[i].norm() * v[i].norm();
+  }
+  return t;
+}
+
+}  // namespace
+
+class DcrStack : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DcrStack, OnFixedGroundIsResolved) {
+  Stack s = make_stack(5, 5, true, 1, GetParam());
+  ASSERT_GT(count_penetrations(s, s.x_new), 0);
+  const std::vector<Vec3> x0 = s.x_new, v0 = s.v;
+  const Coloring c = color_pairs(s);
+  const DcrResult r = run(s, {0.5, 0.3, 1e-6, 200}, c);
+  EXPECT_FALSE(r.capped);
+  EXPECT_GT(r.contacts, 0);
+  EXPECT_GE(r.sweeps, 2);
+  EXPECT_GT(r.dissipated, 0);
+  EXPECT_EQ(count_penetrations(s, s.x_new), 0);
+  for (size_t i = 0; i < s.x_new.size(); ++i)
+    if (s.inv_mass[i] == 0) {
+      EXPECT_EQ(s.x_new[i], x0[i]);
+      EXPECT_EQ(s.v[i], v0[i]);
+    }
+  RecordProperty("pairs", static_cast<int>(s.pairs.size()));
+  RecordProperty("colors", c.num_colors());
+  RecordProperty("contacts", r.contacts);
+  RecordProperty("sweeps", r.sweeps);
+}
+
+INSTANTIATE_TEST_SUITE_P(DcrSweep, DcrStack, ::testing::Values(false, true),
+                         [](const auto& info) { return info.param ? "ThinSheets" : "ThickBodies"; });
+
+TEST(DcrSweep, OnePairPerColorAlsoResolves) {
+  Stack s = make_stack(4, 4, true, 2, true);
+  Coloring c;
+  for (Index i = 0; i <= static_cast<Index>(s.pairs.size()); ++i) c.offsets.push_back(i);
+  for (Index i = 0; i < static_cast<Index>(s.pairs.size()); ++i) c.items.push_back(i);
+  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200}, c);
+  EXPECT_FALSE(r.capped);
+  EXPECT_EQ(count_penetrations(s, s.x_new), 0);
+}
+
+TEST(DcrSweep, ElasticFrictionlessStackConservesMomentumAndEnergy) {
+  Stack s = make_stack(5, 4, false, 3, true);
+  const Totals before = totals(s, s.x_new, s.v);
+  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200}, color_pairs(s));
+  const Totals after = totals(s, s.x_new, s.v);
+  EXPECT_FALSE(r.capped);
+  EXPECT_GT(r.contacts, 0);
+  EXPECT_EQ(r.dissipated, 0.0);
+  EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
+  EXPECT_CLOSE(after.kinetic, before.kinetic, 1e-13, 0);
+  RecordProperty("rel_linear_momentum_error", sci((after.p - before.p).norm() / before.p_scale));
+  RecordProperty("rel_kinetic_energy_error", sci(std::abs(after.kinetic / before.kinetic - 1)));
+}
+
+TEST(DcrSweep, DissipationMatchesTheKineticEnergyLost) {
+  Stack s = make_stack(5, 4, false, 4, true);
+  const Totals before = totals(s, s.x_new, s.v);
+  const DcrResult r = run(s, {0.3, 0.4, 1e-6, 200}, color_pairs(s));
+  const Totals after = totals(s, s.x_new, s.v);
+  EXPECT_FALSE(r.capped);
+  EXPECT_GT(r.dissipated, 0);
+  EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
+  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated, 0, 1e-13 * before.kinetic);
+}
+
+TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
+  // Separate vertex-face impacts (no shared nodes): each resolved once, so the angular
+  // momentum about the origin, at the final positions, is unchanged to round-off.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Stack s;
+  for (int k = 0; k < 50; ++k) {
+    const Vec3 o(4.0 * k, 3 * u(rng), 3 * u(rng));
+    const std::array<Vec3, 4> x{o + Vec3(0.3, 0.3, 0.1 + 0.05 * u(rng)), o, o + Vec3(1, 0.1 * u(rng), 0),
+                                o + Vec3(0.1 * u(rng), 1, 0)};
+    const Vec3 vp(0.2 * u(rng), 0.2 * u(rng), -0.5 + 0.1 * u(rng));
+    const Index first = static_cast<Index>(s.x_old.size());
+    for (int i = 0; i < 4; ++i) {
+      const Vec3 vel = i == 0 ? vp : Vec3(0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng));
+      s.x_old.push_back(x[i]);
+      s.x_new.push_back(x[i] + vel);
+      s.v.push_back(vel);
+      s.inv_mass.push_back(1 / (1.5 + u(rng)));
+    }
+    s.pairs.push_back({ContactPair::VertexFace, {first, first + 1, first + 2, first + 3}});
+  }
+  const std::vector<Vec3> v0 = s.v;
+  const Coloring c = color_pairs(s);
+  EXPECT_EQ(c.num_colors(), 1);
+  const DcrResult r = run(s, {1.0, 0.5, 1e-6, 10}, c);
+  EXPECT_EQ(r.contacts, 50);
+  EXPECT_EQ(r.sweeps, 2);
+  const Totals before = totals(s, s.x_new, v0), after = totals(s, s.x_new, s.v);
+  EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
+  EXPECT_LT((after.L - before.L).norm(), 1e-13 * before.L_scale);
+  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated, 0, 1e-13 * before.kinetic);
+  RecordProperty("rel_angular_momentum_error", sci((after.L - before.L).norm() / before.L_scale));
+}
+
+TEST(DcrSweep, CapIsReported) {
+  Stack s = make_stack(4, 4, true, 6);
+  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 1}, color_pairs(s));
+  EXPECT_EQ(r.sweeps, 1);
+  EXPECT_TRUE(r.capped);
+}
+
+TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
+  const Stack initial = make_stack(5, 6, true, 7, true);
+  const Coloring c = color_pairs(initial);
+  const tbb::global_control allow(tbb::global_control::max_allowed_parallelism, 4);  // even on fewer cores
+  std::vector<Stack> runs;
+  std::vector<DcrResult> results;
+  for (const int threads : {1, 2, 4}) {
+    Stack s = initial;
+    tbb::task_arena arena(threads);
+    results.push_back(arena.execute([&] { return run(s, {0.4, 0.3, 1e-6, 200}, c); }));
+    runs.push_back(std::move(s));
+  }
+  for (size_t k = 1; k < runs.size(); ++k) {
+    EXPECT_EQ(std::memcmp(runs[k].x_new.data(), runs[0].x_new.data(), runs[0].x_new.size() * sizeof(Vec3)), 0);
+    EXPECT_EQ(std::memcmp(runs[k].v.data(), runs[0].v.data(), runs[0].v.size() * sizeof(Vec3)), 0);
+    EXPECT_EQ(std::memcmp(&results[k].dissipated, &results[0].dissipated, sizeof(double)), 0);
+    EXPECT_EQ(results[k].contacts, results[0].contacts);
+    EXPECT_EQ(results[k].sweeps, results[0].sweeps);
+  }
+  EXPECT_EQ(count_penetrations(runs[0], runs[0].x_new), 0);
+}
