@@ -96,23 +96,26 @@ ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& bo
   tbb::parallel_invoke([&] { triangles = build_sparse_bucket(boxes.triangles); },
                        [&] { edges = build_sparse_bucket(boxes.edges); });
   PairBuffers buffers;
-  const size_t nv = boxes.vertices.size(), ne = boxes.edges.size();
-  // One range over vertex queries followed by edge queries, so both kinds
-  // share the load balancing.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + ne, 256), [&](const tbb::blocked_range<size_t>& r) {
+  // One range of independent tasks: vertex queries against the triangles,
+  // then the edge self join by cells, then edges against larger edges on
+  // higher levels (none when all edges share one level).
+  const size_t nv = boxes.vertices.size(), nc = edges.cell_key.size();
+  const size_t ne_above = edges.num_levels() > 1 ? boxes.edges.size() : 0;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + nc + ne_above, 64), [&](const tbb::blocked_range<size_t>& r) {
     ContactPairs& out = buffers.local();
+    auto add_edge_pair = [&](Index a, Index b) {
+      if (auto p = edge_edge_pair(surface, std::min(a, b), std::max(a, b))) out.push_back(*p);
+    };
     for (size_t k = r.begin(); k != r.end(); ++k) {
       if (k < nv) {
         const auto v = static_cast<Index>(k);
         query_sparse_bucket(triangles, boxes.triangles, boxes.vertices[k], [&](Index t) {
           if (auto p = vertex_face_pair(surface, v, t)) out.push_back(*p);
         });
+      } else if (k < nv + nc) {
+        self_join_sparse_bucket_cell(edges, boxes.edges, static_cast<Index>(k - nv), add_edge_pair);
       } else {
-        const auto e = static_cast<Index>(k - nv);
-        query_sparse_bucket(edges, boxes.edges, boxes.edges[e], [&](Index f) {
-          if (e < f)
-            if (auto p = edge_edge_pair(surface, e, f)) out.push_back(*p);
-        });
+        self_join_sparse_bucket_above(edges, boxes.edges, static_cast<Index>(k - nv - nc), add_edge_pair);
       }
     }
   });

@@ -82,11 +82,8 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
       tbb::blocked_range<size_t>(0, n), 0,
       [&](const tbb::blocked_range<size_t>& r, int acc) {
         for (size_t k = r.begin(); k != r.end(); ++k) {
-          const double s = largest_side(boxes[k]);
-          int l = 0;
-          for (double h = h0; s > h; h *= 4.0) ++l;
-          level[k] = l;
-          acc = std::max(acc, l);
+          level[k] = sparse_bucket_level(h0, boxes[k]);
+          acc = std::max(acc, level[k]);
         }
         return acc;
       },

@@ -88,54 +88,105 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes);
 /// Bytes held by the structure's arrays (the boxes themselves not included).
 std::size_t memory_bytes(const SparseBucket& bucket);
 
+/// Level of a box in a structure with base cell side h0: the smallest l with
+/// largest side <= h0 4^l.
+inline int sparse_bucket_level(double h0, const Box& x) {
+  const double side = (x.hi - x.lo).maxCoeff();
+  int l = 0;
+  for (double h = h0; side > h; h *= 4.0) ++l;
+  return l;
+}
+
+/// Call report(id) once for every box on level l that overlaps q (see
+/// query_sparse_bucket).
+template <class Report>
+void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes, const Box& q, int l,
+                               Report&& report) {
+  const int u = b.axis[0], v = b.axis[1], w = b.axis[2];
+  constexpr double kRound = 4 * std::numeric_limits<double>::epsilon();
+  const std::uint64_t i0 = b.cell(0, l, q.lo[u]), i1 = b.cell(0, l, q.hi[u]);
+  const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
+  const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
+  // Walk only the non-empty cells of rows i0..i1, jumping over gaps by bisection.
+  auto it = std::lower_bound(first, last, SparseBucket::key(l, i0, j0));
+  while (it != last) {
+    const std::uint64_t i = (*it >> SparseBucket::kCellBits) & SparseBucket::kCellMask;
+    const std::uint64_t j = *it & SparseBucket::kCellMask;
+    if (i > i1) break;
+    if (j < j0) {
+      it = std::lower_bound(it, last, SparseBucket::key(l, i, j0));
+      continue;
+    }
+    if (j > j1) {
+      it = std::lower_bound(it, last, SparseBucket::key(l, i + 1, j0));
+      continue;
+    }
+    const auto c = static_cast<Index>(it - b.cell_key.begin());
+    // Boxes with lo_w < q.lo_w - max extent end before q; the slack keeps
+    // the bisection conservative under rounding, the exact test decides.
+    const double m = b.cell_max_extent[c];
+    const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m);
+    const auto lo_first = b.entry_lo.begin() + b.cell_entries[c];
+    const auto lo_last = b.entry_lo.begin() + b.cell_entries[c + 1];
+    const auto e_end = static_cast<size_t>(b.cell_entries[c + 1]);
+    for (auto e = static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
+         e != e_end && b.entry_lo[e] <= q.hi[w]; ++e) {
+      // float bounds are rounded outward, so this filter never drops an overlap
+      const auto& uv = b.entry_uv[e];
+      if (b.entry_hi[e] < q.lo[w] || uv[0] > q.hi[u] || uv[1] < q.lo[u] || uv[2] > q.hi[v] || uv[3] < q.lo[v])
+        continue;
+      const Index id = b.entry_box[e];
+      const Box& x = boxes[id];
+      if (!boxes_overlap(q, x)) continue;
+      if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i && b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
+        report(id);
+    }
+    ++it;
+  }
+}
+
 /// Call report(id) once for every box of `boxes` (the span the structure was
 /// built on) that overlaps q. Each pair is reported from one cell only: the
 /// cell that holds the lowest corner of the intersection, max(q.lo, box.lo).
 template <class Report>
 void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, const Box& q, Report&& report) {
-  const int u = b.axis[0], v = b.axis[1], w = b.axis[2];
-  constexpr double kRound = 4 * std::numeric_limits<double>::epsilon();
-  for (int l = 0; l < b.num_levels(); ++l) {
-    const std::uint64_t i0 = b.cell(0, l, q.lo[u]), i1 = b.cell(0, l, q.hi[u]);
-    const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
-    const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
-    // Walk only the non-empty cells of rows i0..i1, jumping over gaps by bisection.
-    auto it = std::lower_bound(first, last, SparseBucket::key(l, i0, j0));
-    while (it != last) {
-      const std::uint64_t i = (*it >> SparseBucket::kCellBits) & SparseBucket::kCellMask;
-      const std::uint64_t j = *it & SparseBucket::kCellMask;
-      if (i > i1) break;
-      if (j < j0) {
-        it = std::lower_bound(it, last, SparseBucket::key(l, i, j0));
-        continue;
-      }
-      if (j > j1) {
-        it = std::lower_bound(it, last, SparseBucket::key(l, i + 1, j0));
-        continue;
-      }
-      const auto c = static_cast<Index>(it - b.cell_key.begin());
-      // Boxes with lo_w < q.lo_w - max extent end before q; the slack keeps
-      // the bisection conservative under rounding, the exact test decides.
-      const double m = b.cell_max_extent[c];
-      const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m);
-      const auto lo_first = b.entry_lo.begin() + b.cell_entries[c];
-      const auto lo_last = b.entry_lo.begin() + b.cell_entries[c + 1];
-      const auto e_end = static_cast<size_t>(b.cell_entries[c + 1]);
-      for (auto e = static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
-           e != e_end && b.entry_lo[e] <= q.hi[w]; ++e) {
-        // float bounds are rounded outward, so this filter never drops an overlap
-        const auto& uv = b.entry_uv[e];
-        if (b.entry_hi[e] < q.lo[w] || uv[0] > q.hi[u] || uv[1] < q.lo[u] || uv[2] > q.hi[v] || uv[3] < q.lo[v])
-          continue;
-        const Index id = b.entry_box[e];
-        const Box& x = boxes[id];
-        if (!boxes_overlap(q, x)) continue;
-        if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i && b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
-          report(id);
-      }
-      ++it;
+  for (int l = 0; l < b.num_levels(); ++l) query_sparse_bucket_level(b, boxes, q, l, report);
+}
+
+/// Self join, part 1: call report(a, b) for every overlapping pair of boxes
+/// of cell c's level whose intersection's lowest corner lies in cell c, by a
+/// sweep along w over the cell's sorted entries: O(entries + pairs tested).
+/// Over all cells c in [0, C) every overlapping same-level pair comes once.
+template <class Report>
+void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> boxes, Index c, Report&& report) {
+  const int u = b.axis[0], v = b.axis[1];
+  const std::uint64_t key = b.cell_key[c];
+  const int l = static_cast<int>(key >> (2 * SparseBucket::kCellBits));
+  const std::uint64_t i = (key >> SparseBucket::kCellBits) & SparseBucket::kCellMask;
+  const std::uint64_t j = key & SparseBucket::kCellMask;
+  const auto end = static_cast<size_t>(b.cell_entries[c + 1]);
+  for (auto p = static_cast<size_t>(b.cell_entries[c]); p != end; ++p) {
+    const auto& up = b.entry_uv[p];
+    const Box& x = boxes[b.entry_box[p]];
+    for (size_t q = p + 1; q != end && b.entry_lo[q] <= b.entry_hi[p]; ++q) {
+      const auto& uq = b.entry_uv[q];
+      if (uq[0] > up[1] || uq[1] < up[0] || uq[2] > up[3] || uq[3] < up[2]) continue;
+      const Box& y = boxes[b.entry_box[q]];
+      if (!boxes_overlap(x, y)) continue;
+      if (b.cell(0, l, std::max(x.lo[u], y.lo[u])) == i && b.cell(1, l, std::max(x.lo[v], y.lo[v])) == j)
+        report(b.entry_box[p], b.entry_box[q]);
     }
   }
+}
+
+/// Self join, part 2: call report(k, id) for every box id on a level above
+/// box k's that overlaps box k. With part 1 over all cells and part 2 over
+/// all boxes, every overlapping pair of distinct boxes comes exactly once.
+template <class Report>
+void self_join_sparse_bucket_above(const SparseBucket& b, std::span<const Box> boxes, Index k, Report&& report) {
+  if (b.num_levels() < 2) return;
+  for (int l = sparse_bucket_level(b.cell_size[0], boxes[k]) + 1; l < b.num_levels(); ++l)
+    query_sparse_bucket_level(b, boxes, boxes[k], l, [&](Index id) { report(k, id); });
 }
 
 }  // namespace shatter
