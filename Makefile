@@ -3,7 +3,7 @@
 #   make test   install dependencies, build, run every test
 BUILD ?= build
 JOBS  ?= $(shell nproc)
-SCENE ?= scenes/bar_wave.yaml
+SCENE ?= scenes/two_cylinders.yaml
 THREADS ?= $(shell nproc)
 
 .PHONY: all deps build run test bench clean

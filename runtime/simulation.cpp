@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/contact_stage.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
@@ -45,6 +46,12 @@ Simulation::Simulation(Model& model, RunOptions options)
     if (model_.bc_mask[i]) bc_nodes_.push_back(i);
   }
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
+  if (model_.scene.contact) {
+    contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
+    // DCR treats a node with any prescribed component as immovable.
+    contact_inv_mass_.resize(n);
+    for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
+  }
   compute_forces();
   update_ledger();
   total0_ = ledger_.total();
@@ -117,11 +124,26 @@ void Simulation::step() {
       for (int c = 0; c < 3; ++c)
         if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
   });
-  const double gravity_work = g.squaredNorm() == 0 ? 0.0 : deterministic_sum(n, 0.0, [&](Index i) {
-    return model_.mass[i] * g.dot(dt * v_[i]);
-  });
   for (size_t b = 0; b < bc_nodes_.size(); ++b) dx_bc[b] = dt * v_[bc_nodes_[b]];
-  parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
+  if (contact_) {
+    x_prev_ = x_;
+    parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
+    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_);
+    ledger_.contacts = r.contacts;
+    ledger_.contact_dissipated += r.dissipated;
+    if (r.capped) {
+      if (ledger_.contact_capped_steps == 0 && !opt_.quiet)
+        std::fprintf(stderr, "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
+                     "counted in history.csv column contact_capped_steps\n", step_ + 1, r.sweeps);
+      ++ledger_.contact_capped_steps;
+    }
+  } else {
+    parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
+  }
+  // Gravity's work over the step's displacement (the projection's included).
+  const double gravity_work = g.squaredNorm() == 0 ? 0.0 : deterministic_sum(n, 0.0, [&](Index i) {
+    return model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
+  });
 
   compute_forces();
 
@@ -164,7 +186,7 @@ void Simulation::write_outputs(bool fields) {
   *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
             << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
             << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
-            << l.contacts << l.cohesive_elements << l.fragments;
+            << l.contacts << l.cohesive_elements << l.fragments << l.contact_capped_steps;
   history_->end_row();
 
   const Mesh& mesh = model_.mesh;
@@ -217,7 +239,7 @@ long Simulation::run() {
         opt_.out_dir / "history.csv",
         std::vector<std::string>{"step", "time", "dt", "kinetic", "strain", "cohesive_stored", "cohesive_dissipated",
                                  "contact_dissipated", "external_work", "total", "px", "py", "pz", "Lx", "Ly", "Lz",
-                                 "contacts", "cohesive_elements", "fragments"});
+                                 "contacts", "cohesive_elements", "fragments", "contact_capped_steps"});
     bodies_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "bodies.csv",
         std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"});
@@ -273,6 +295,12 @@ void Simulation::write_summary(double wall) {
   j.add("contacts", l.contacts);
   j.add("cohesive_elements", l.cohesive_elements);
   j.add("fragments", l.fragments);
+  j.add("contact_capped_steps", l.contact_capped_steps);
+  if (contact_) {
+    j.add("contact_search_time", contact_->search_seconds());
+    j.add("contact_dcr_time", contact_->dcr_seconds());
+    j.add("contact_surface_triangles", static_cast<long>(contact_->surface().num_triangles()));
+  }
   j.write(opt_.out_dir / "summary.json");
 }
 

@@ -22,6 +22,7 @@ namespace shatter {
 
 class FieldWriter;
 class CsvWriter;
+class ContactStage;
 
 struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
@@ -38,6 +39,7 @@ struct Ledger {
   Vec3 momentum = Vec3::Zero();          ///< kg m/s
   Vec3 angular_momentum = Vec3::Zero();  ///< about the origin, kg m^2/s
   long contacts = 0, cohesive_elements = 0, fragments = 0;
+  long contact_capped_steps = 0;  ///< steps whose DCR sweeps hit the cap (extra history column)
   /// kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work
   double total() const {
     return kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work;
@@ -67,6 +69,7 @@ class Simulation {
   std::span<const Vec3> internal_forces() const { return f_int_; }
   const Model& model() const { return model_; }
   double element_loop_seconds() const { return element_seconds_; }
+  const ContactStage* contact() const { return contact_.get(); }
 
  private:
   void compute_forces();
@@ -88,6 +91,9 @@ class Simulation {
   ElementLoopResult last_elements_;
   double element_seconds_ = 0;
   double total0_ = 0, energy_scale_ = 0;
+  std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
+  std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
+  std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
   std::unique_ptr<FieldWriter> fields_;
   std::unique_ptr<CsvWriter> history_, bodies_;
 };
