@@ -13,6 +13,7 @@
 #include <random>
 
 #include "contact/dcr.hpp"
+#include "kernels/error.hpp"
 #include "expect_close.hpp"
 #include "runtime/coloring.hpp"
 
@@ -348,4 +349,13 @@ TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
     EXPECT_EQ(results[k].sweeps, results[0].sweeps);
   }
   EXPECT_EQ(count_penetrations(runs[0], runs[0].x_new), 0);
+}
+
+TEST(DcrSweep, RejectsInconsistentInput) {
+  Stack s = make_stack(2, 2, true, 8);
+  const Coloring c = color_pairs(s);
+  std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, {}, {c.offsets, c.items}), Error);
+  const std::vector<Index> no_items;
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, {}, {c.offsets, no_items}), Error);
 }

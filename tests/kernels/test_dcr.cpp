@@ -262,6 +262,23 @@ TEST(DcrProject, RemovesPenetrationKeepsCentreOfMassAndFixedNodes) {
   }
 }
 
+TEST(DcrProject, NearlyParallelEdgesAreSeparatedNotTilted) {
+  // Edge a sinks 0.1 through edge b at 3 degrees to it. Along the contact normal (the
+  // gradient at the contact time) the separation is a pure z move; the gradient at the
+  // penetrated configuration would swing the edges sideways by about depth x length.
+  const double c = std::cos(0.05), s = std::sin(0.05);
+  const PairPoints Xo = points(Vec3(-1, 0, 0.1), Vec3(1, 0, 0.1), Vec3(-c, -s, 0), Vec3(c, s, 0));
+  PairPoints X = points(Vec3(-1, 0, -0.1), Vec3(1, 0, -0.1), Vec3(-c, -s, 0), Vec3(c, s, 0));
+  PairPoints V = Xo - X;
+  const PairPoints Xn = X;
+  const DcrPairResponse r = dcr_resolve_pair(EE, Xo, X, V, PairWeights::Ones(), {1.0, 0.0, 1e-6});
+  ASSERT_TRUE(r.active);
+  EXPECT_TRUE(r.separated);
+  const PairPoints dX = X - Xn;
+  EXPECT_LT(dX.topRows<2>().norm(), 1e-12 * dX.row(2).norm());
+  EXPECT_CLOSE(X(2, 0) - X(2, 2), 1e-6 * 2, 1e-6, 0);  // edge a back above b by the gap
+}
+
 TEST(DcrProject, AllNodesFixedCannotBeResolved) {
   PairPoints X = points(Vec3(0.2, 0.2, -0.1), kA, kB, kC);
   const PairPoints X0 = X;
