@@ -1,5 +1,6 @@
 #include "contact/candidates.hpp"
 
+#include <algorithm>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -38,8 +39,8 @@ void fill_boxes(std::vector<Box>& out, const Nodes& nodes, std::span<const Vec3>
   });
 }
 
-/// Pairs collected in per-thread buffers, concatenated in a fixed order of
-/// the buffers' contents after canonicalize (which makes the order irrelevant).
+/// Pairs collected in per-thread buffers. Which buffer holds a pair depends
+/// on the schedule; canonicalize after concatenation makes the list unique.
 using PairBuffers = tbb::enumerable_thread_specific<ContactPairs>;
 
 ContactPairs concatenate(PairBuffers& buffers) {

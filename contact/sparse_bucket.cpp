@@ -140,15 +140,14 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
 
   const size_t m = entries.size();
   b.entry_lo.resize(m);
-  b.entry_hi.resize(m);
-  b.entry_uv.resize(m);
+  b.entry_bounds.resize(m);
   b.entry_box.resize(m);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, m), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const Box& x = boxes[entries[k].box];
-      b.entry_lo[k] = entries[k].lo;
-      b.entry_hi[k] = x.hi[wa];
-      b.entry_uv[k] = {round_down(x.lo[u]), round_up(x.hi[u]), round_down(x.lo[v]), round_up(x.hi[v])};
+      b.entry_lo[k] = round_down(entries[k].lo);
+      b.entry_bounds[k] = {round_up(x.hi[wa]), round_down(x.lo[u]), round_up(x.hi[u]), round_down(x.lo[v]),
+                           round_up(x.hi[v])};
       b.entry_box[k] = entries[k].box;
     }
   });
@@ -178,8 +177,8 @@ std::size_t memory_bytes(const SparseBucket& b) {
   return sizeof(SparseBucket) + (b.cell_size.capacity() + b.cell_inverse.capacity()) * sizeof(double) +
          b.level_cells.capacity() * sizeof(Index) + b.cell_key.capacity() * sizeof(std::uint64_t) +
          b.cell_entries.capacity() * sizeof(Index) + b.cell_max_extent.capacity() * sizeof(double) +
-         (b.entry_lo.capacity() + b.entry_hi.capacity()) * sizeof(double) +
-         b.entry_uv.capacity() * sizeof(std::array<float, 4>) + b.entry_box.capacity() * sizeof(Index);
+         b.entry_lo.capacity() * sizeof(float) + b.entry_bounds.capacity() * sizeof(std::array<float, 5>) +
+         b.entry_box.capacity() * sizeof(Index);
 }
 
 }  // namespace shatter

@@ -11,6 +11,7 @@
 // w-extent of a cell's boxes is at most h_l. A single huge box sits alone on a
 // high level and costs every query O(1) cell visits, not O(area / h_0^2).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -47,11 +48,14 @@ inline bool boxes_overlap(const Box& a, const Box& b) {
 ///                                   i = floor((x_u - origin_u) / h_l), j likewise along v
 ///   cell_entries[C+1]               entries of cell c: [cell_entries[c], cell_entries[c+1])
 ///   cell_max_extent[C]              max over the cell's boxes of hi_w - lo_w
-///   entry_lo[N]                     lo_w of the box, ascending within a cell (ties by id)
-///   entry_hi[N]                     hi_w of the box
-///   entry_uv[N]                     {lo_u, hi_u, lo_v, hi_v} of the box in float, rounded
-///                                   outward: a cache-friendly filter before the exact test
+///   entry_lo[N]                     lo_w of the box as a float rounded down, ascending
+///                                   within a cell (entries sorted by the exact lo_w, then id)
+///   entry_bounds[N]                 {hi_w, lo_u, hi_u, lo_v, hi_v} of the box as floats
+///                                   rounded outward
 ///   entry_box[N]                    box id
+/// The float bounds contain the box, so they filter the candidates of a cell
+/// from contiguous memory (28 bytes an entry) without dropping an overlap; only
+/// the survivors are tested exactly on the double boxes.
 struct SparseBucket {
   std::array<int, 3> axis = {0, 1, 2};
   std::array<double, 2> origin = {0, 0};
@@ -61,9 +65,8 @@ struct SparseBucket {
   std::vector<std::uint64_t> cell_key;
   std::vector<Index> cell_entries = {0};
   std::vector<double> cell_max_extent;
-  std::vector<double> entry_lo;
-  std::vector<double> entry_hi;
-  std::vector<std::array<float, 4>> entry_uv;
+  std::vector<float> entry_lo;
+  std::vector<std::array<float, 5>> entry_bounds;
   std::vector<Index> entry_box;
 
   int num_levels() const { return static_cast<int>(cell_size.size()); }
@@ -103,7 +106,9 @@ template <class Report>
 void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes, const Box& q, int l,
                                Report&& report) {
   const int u = b.axis[0], v = b.axis[1], w = b.axis[2];
-  constexpr double kRound = 4 * std::numeric_limits<double>::epsilon();
+  // relative size of a float ulp, twice, plus the smallest normal float
+  constexpr double kRound = 0x1p-22;
+  constexpr double kTiny = std::numeric_limits<float>::min();
   const std::uint64_t i0 = b.cell(0, l, q.lo[u]), i1 = b.cell(0, l, q.hi[u]);
   const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
   const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
@@ -122,19 +127,17 @@ void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes
       continue;
     }
     const auto c = static_cast<Index>(it - b.cell_key.begin());
-    // Boxes with lo_w < q.lo_w - max extent end before q; the slack keeps
-    // the bisection conservative under rounding, the exact test decides.
+    // Boxes with lo_w < q.lo_w - max extent end before q; the slack covers
+    // the float rounding of entry_lo, so the bisection stays conservative.
     const double m = b.cell_max_extent[c];
-    const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m);
+    const double w_from = q.lo[w] - m - kRound * (std::abs(q.lo[w]) + m) - kTiny;
     const auto lo_first = b.entry_lo.begin() + b.cell_entries[c];
     const auto lo_last = b.entry_lo.begin() + b.cell_entries[c + 1];
     const auto e_end = static_cast<size_t>(b.cell_entries[c + 1]);
     for (auto e = static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
          e != e_end && b.entry_lo[e] <= q.hi[w]; ++e) {
-      // float bounds are rounded outward, so this filter never drops an overlap
-      const auto& uv = b.entry_uv[e];
-      if (b.entry_hi[e] < q.lo[w] || uv[0] > q.hi[u] || uv[1] < q.lo[u] || uv[2] > q.hi[v] || uv[3] < q.lo[v])
-        continue;
+      const auto& f = b.entry_bounds[e];
+      if (f[0] < q.lo[w] || f[1] > q.hi[u] || f[2] < q.lo[u] || f[3] > q.hi[v] || f[4] < q.lo[v]) continue;
       const Index id = b.entry_box[e];
       const Box& x = boxes[id];
       if (!boxes_overlap(q, x)) continue;
@@ -166,11 +169,11 @@ void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> bo
   const std::uint64_t j = key & SparseBucket::kCellMask;
   const auto end = static_cast<size_t>(b.cell_entries[c + 1]);
   for (auto p = static_cast<size_t>(b.cell_entries[c]); p != end; ++p) {
-    const auto& up = b.entry_uv[p];
+    const auto& fp = b.entry_bounds[p];
     const Box& x = boxes[b.entry_box[p]];
-    for (size_t q = p + 1; q != end && b.entry_lo[q] <= b.entry_hi[p]; ++q) {
-      const auto& uq = b.entry_uv[q];
-      if (uq[0] > up[1] || uq[1] < up[0] || uq[2] > up[3] || uq[3] < up[2]) continue;
+    for (size_t q = p + 1; q != end && b.entry_lo[q] <= fp[0]; ++q) {
+      const auto& fq = b.entry_bounds[q];
+      if (fq[1] > fp[2] || fq[2] < fp[1] || fq[3] > fp[4] || fq[4] < fp[3]) continue;
       const Box& y = boxes[b.entry_box[q]];
       if (!boxes_overlap(x, y)) continue;
       if (b.cell(0, l, std::max(x.lo[u], y.lo[u])) == i && b.cell(1, l, std::max(x.lo[v], y.lo[v])) == j)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <tuple>
 
 #include "kernels/error.hpp"
 #include "kernels/tet10.hpp"
