@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstdint>
 
 #include "kernels/error.hpp"
@@ -48,11 +49,21 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
   std::vector<double> dissipated(pairs.size(), 0.0);
   std::vector<std::uint8_t> ever_active(pairs.size(), 0);
   std::vector<std::uint8_t> active_now(pairs.size(), 0);
+  // The last sweep in which each node was moved (0 = never). A pair none of whose nodes
+  // moved since its last check would be found clean again, so from the second sweep on
+  // only pairs with a node moved in this or the previous sweep are checked: the same
+  // result as checking them all, at the cost of the neighbourhood of the active pairs.
+  std::vector<int> moved_in_sweep(n_nodes, 0);
 
-  auto resolve = [&](Index i) {
+  auto resolve = [&](Index i, int sweep) {
     const ContactPair& pair = pairs[i];
     active_now[i] = 0;
     if (!distinct_nodes(pair)) return;
+    if (sweep > 1) {
+      int last_move = 0;
+      for (const Index n : pair.nodes) last_move = std::max(last_move, moved_in_sweep[n]);
+      if (last_move < sweep - 1) return;
+    }
     PairPoints X_old, X_new, V;
     PairWeights w;
     for (int k = 0; k < 4; ++k) {
@@ -72,6 +83,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
       const Index n = pair.nodes[k];
       x_new[n] = X_new.col(k);
       v[n] = V.col(k);
+      moved_in_sweep[n] = sweep;
     }
   };
 
@@ -82,7 +94,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
     for (size_t c = 0; c + 1 < colors.offsets.size(); ++c) {
       const auto group = colors.items.subspan(colors.offsets[c], colors.offsets[c + 1] - colors.offsets[c]);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k != r.end(); ++k) resolve(group[k]);
+        for (size_t k = r.begin(); k != r.end(); ++k) resolve(group[k], result.sweeps);
       });
     }
     converged = true;
