@@ -8,6 +8,7 @@
 // (e.g. Sifakis & Barbic, "FEM simulation of 3D deformable solids", SIGGRAPH
 // 2012 course notes, sec. 4.2).
 #include <array>
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 
@@ -69,6 +70,7 @@ struct Tet4Lanes {
   double f[12][N];       ///< out: internal nodal forces dE/dx, f[3a + i][l], N
   double energy[N];      ///< out: strain energy V0 W, J
   double J[N];           ///< out: det F
+  double lnJ[N];         ///< out: ln det F (for NeoHookean wave speed without a second log)
 };
 
 /// TET4 Neo-Hookean internal forces of N elements at once. Same formulas as
@@ -81,7 +83,8 @@ struct Tet4Lanes {
 template <int N>
 inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
   const double mu = mat.mu, lambda = mat.lambda;
-  double F[9][N], C[9][N], detF[N], lnJ[N];
+  double F[9][N], C[9][N], detF[N];
+  double* lnJ = L.lnJ;
   for (int l = 0; l < N; ++l) {
     // Ds columns d[3k + i] = x_{k+1,i} - x_{0,i};  F = Ds Dm^-1, F[3j + i] = F(i, j)
     double d[9];
@@ -120,6 +123,41 @@ inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
     for (int i = 0; i < 3; ++i) L.f[i][l] = -(L.f[3 + i][l] + L.f[6 + i][l] + L.f[9 + i][l]);
     L.energy[l] = V0 * (0.5 * mu * (I1 - 3.0) - mu * lnJ[l] + 0.5 * lambda * lnJ[l] * lnJ[l]);
     L.J[l] = detF[l];
+  }
+}
+
+/// Squared stable time step of N TET4 Neo-Hookean elements, s^2, after
+/// tet4_neo_hookean_lanes(L, mat): dt^2 = h^2 / c^2 with h = tet4_stable_length
+/// (half the smallest altitude, h^2 = (6V)^2 / (4 max (2 A_face)^2), no square
+/// root) and c = mat.wave_speed(J) from L.lnJ (no second log); J <= 0 or NaN
+/// uses the reference wave speed, as the runtime does. Take the minimum over a
+/// block and one square root: sqrt is monotone, so sqrt(min dt^2) = min sqrt(dt^2).
+/// Same value as h / wave_speed(J) up to rounding (a few ulp), ~2x cheaper
+/// than both calls (which cost as much as the force kernel itself).
+template <int N>
+inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+  const double ref_stiff = mat.lambda + 2.0 * mat.mu;
+  for (int l = 0; l < N; ++l) {
+    double d[9];  // ab, ac, ad
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) d[3 * k + i] = L.x[3 * (k + 1) + i][l] - L.x[i][l];
+    const double bc[3] = {d[3] - d[0], d[4] - d[1], d[5] - d[2]};
+    const double bd[3] = {d[6] - d[0], d[7] - d[1], d[8] - d[2]};
+    auto cross_sq = [](const double* u, const double* v, double* w) {
+      w[0] = u[1] * v[2] - u[2] * v[1];
+      w[1] = u[2] * v[0] - u[0] * v[2];
+      w[2] = u[0] * v[1] - u[1] * v[0];
+      return w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    };
+    double w[3], cd[3];
+    const double a0 = cross_sq(d, d + 3, w), a1 = cross_sq(d, d + 6, w), a3 = cross_sq(bc, bd, w);
+    const double a2 = cross_sq(d + 3, d + 6, cd);
+    const double six_volume = d[0] * cd[0] + d[1] * cd[1] + d[2] * cd[2];
+    const double twice_area_sq = std::max(std::max(a0, a1), std::max(a2, a3));
+    const double h2 = 0.25 * (six_volume * six_volume) / twice_area_sq;
+    const double stiff =
+        L.J[l] > 0 ? std::max(ref_stiff - 2.0 * mat.lambda * L.lnJ[l], ref_stiff) : ref_stiff;
+    dt2[l] = h2 * mat.density / stiff;
   }
 }
 
