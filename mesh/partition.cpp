@@ -56,8 +56,9 @@ std::vector<Index> order_by_gid(const std::vector<Index>& items, const std::vect
   std::vector<Index> sorted = items;
   std::sort(sorted.begin(), sorted.end(), [&](Index a, Index b) { return gid[a] < gid[b]; });
   for (size_t i = 1; i < sorted.size(); ++i)
-    SHATTER_REQUIRE(gid[sorted[i - 1]] != gid[sorted[i]],
-                    "extract_subdomain: " << what << " global id " << gid[sorted[i]] << " appears twice");
+    SHATTER_REQUIRE(
+        gid[sorted[i - 1]] != gid[sorted[i]],
+        "extract_subdomain: " << what << " global id " << gid[sorted[i]] << " appears twice");
   return sorted;
 }
 
@@ -65,8 +66,8 @@ std::vector<Index> order_by_gid(const std::vector<Index>& items, const std::vect
 
 std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed) {
   const Index ne = mesh.num_elements();
-  SHATTER_REQUIRE(parts >= 1 && parts <= ne,
-                  "partition_elements: cannot cut " << ne << " elements into " << parts << " parts");
+  SHATTER_REQUIRE(parts >= 1 && parts <= ne, "partition_elements: cannot cut "
+                                                 << ne << " elements into " << parts << " parts");
   if (parts == 1) return std::vector<int>(ne, 0);
 
   // Corner nodes only: a TET10 face shares 3 corners exactly when a TET4 face does.
@@ -78,8 +79,10 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed) {
   eptr[ne] = 4 * ne;
   idx_t n_elem = ne, n_node = mesh.num_nodes(), ncommon = 3, numflag = 0;
   idx_t *xadj = nullptr, *adjncy = nullptr;
-  int status = METIS_MeshToDual(&n_elem, &n_node, eptr.data(), eind.data(), &ncommon, &numflag, &xadj, &adjncy);
-  SHATTER_REQUIRE(status == METIS_OK, "partition_elements: METIS_MeshToDual failed with status " << status);
+  int status = METIS_MeshToDual(&n_elem, &n_node, eptr.data(), eind.data(), &ncommon, &numflag,
+                                &xadj, &adjncy);
+  SHATTER_REQUIRE(status == METIS_OK,
+                  "partition_elements: METIS_MeshToDual failed with status " << status);
 
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
@@ -87,19 +90,21 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed) {
   options[METIS_OPTION_NUMBERING] = 0;
   idx_t ncon = 1, nparts = parts, edgecut = 0;
   std::vector<idx_t> part(ne);
-  status = METIS_PartGraphKway(&n_elem, &ncon, xadj, adjncy, nullptr, nullptr, nullptr, &nparts, nullptr, nullptr,
-                               options, &edgecut, part.data());
+  status = METIS_PartGraphKway(&n_elem, &ncon, xadj, adjncy, nullptr, nullptr, nullptr, &nparts,
+                               nullptr, nullptr, options, &edgecut, part.data());
   METIS_Free(xadj);
   METIS_Free(adjncy);
-  SHATTER_REQUIRE(status == METIS_OK, "partition_elements: METIS_PartGraphKway failed with status " << status);
+  SHATTER_REQUIRE(status == METIS_OK,
+                  "partition_elements: METIS_PartGraphKway failed with status " << status);
   return std::vector<int>(part.begin(), part.end());
 }
 
 LocalMesh extract_subdomain(const Mesh& global, std::span<const int> elem_part, int rank) {
   const Index ne = global.num_elements(), nn = global.num_nodes();
   const int k = global.nodes_per_element();
-  SHATTER_REQUIRE(static_cast<Index>(elem_part.size()) == ne,
-                  "extract_subdomain: " << elem_part.size() << " parts given for " << ne << " elements");
+  SHATTER_REQUIRE(
+      static_cast<Index>(elem_part.size()) == ne,
+      "extract_subdomain: " << elem_part.size() << " parts given for " << ne << " elements");
   SHATTER_REQUIRE(static_cast<Index>(global.node_elem_offsets.size()) == nn + 1,
                   "extract_subdomain: the global mesh has no node -> element CSR");
   const NodeRanks touch = touching_ranks(global, elem_part);
@@ -150,7 +155,7 @@ LocalMesh extract_subdomain(const Mesh& global, std::span<const int> elem_part, 
 
   // A rank holds element e exactly when it touches one of e's nodes, so the
   // ranks holding node n are the union of touch(m) over the nodes m of its star.
-  std::map<int, std::vector<Index>> shared, send, recv;
+  std::map<int, std::vector<Index>> shared, send, recv, only_send, only_recv;
   std::vector<int> holders;
   for (Index i = 0; i < static_cast<Index>(nodes.size()); ++i) {
     const Index n = nodes[i];
@@ -159,6 +164,7 @@ LocalMesh extract_subdomain(const Mesh& global, std::span<const int> elem_part, 
         if (q != rank) shared[q].push_back(i);
     if (local.node_owner[i] != rank) {
       recv[local.node_owner[i]].push_back(i);
+      if (!touched[n]) only_recv[local.node_owner[i]].push_back(i);
       continue;
     }
     holders.clear();
@@ -171,12 +177,18 @@ LocalMesh extract_subdomain(const Mesh& global, std::span<const int> elem_part, 
     }
     std::sort(holders.begin(), holders.end());
     holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
-    for (int q : holders)
-      if (q != rank) send[q].push_back(i);
+    const auto touching = touch.of(n);
+    for (int q : holders) {
+      if (q == rank) continue;
+      send[q].push_back(i);
+      if (!std::binary_search(touching.begin(), touching.end(), q)) only_send[q].push_back(i);
+    }
   }
   local.shared = exchange_from(shared);
   local.ghost_send = exchange_from(send);
   local.ghost_recv = exchange_from(recv);
+  local.ghost_only_send = exchange_from(only_send);
+  local.ghost_only_recv = exchange_from(only_recv);
   return local;
 }
 

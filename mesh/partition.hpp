@@ -58,8 +58,12 @@ struct NodeExchange {
 ///                   the partial sums of halo summation go both ways
 ///   ghost_send      nodes owned here, per other rank holding them
 ///   ghost_recv      nodes held here and owned elsewhere, per owner
+///   ghost_only_send the part of ghost_send that the receiving rank does not
+///                   touch (it holds them only through ghost elements)
+///   ghost_only_recv the part of ghost_recv not touched here
 /// shared.nodes_of(q) on rank r lists the same global nodes, in the same order,
-/// as shared.nodes_of(r) on rank q; likewise ghost_send on r and ghost_recv on q.
+/// as shared.nodes_of(r) on rank q; likewise ghost_send on r and ghost_recv on
+/// q, and ghost_only_send on r and ghost_only_recv on q.
 struct LocalMesh {
   int rank = 0;
   Mesh mesh;
@@ -69,6 +73,8 @@ struct LocalMesh {
   NodeExchange shared;
   NodeExchange ghost_send;
   NodeExchange ghost_recv;
+  NodeExchange ghost_only_send;
+  NodeExchange ghost_only_recv;
 
   bool owns_element(Index e) const { return elem_owner[e] == rank; }
   bool owns_node(Index n) const { return node_owner[n] == rank; }

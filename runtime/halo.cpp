@@ -11,11 +11,18 @@ constexpr int kSumTag = 601;
 constexpr int kUpdateTag = 602;
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are read as node-major doubles");
 
-std::span<double> as_doubles(std::span<Vec3> v) { return {v.empty() ? nullptr : v.data()->data(), 3 * v.size()}; }
+std::span<double> as_doubles(std::span<Vec3> v) {
+  return {v.empty() ? nullptr : v.data()->data(), 3 * v.size()};
+}
 }  // namespace
 
 Halo::Halo(const LocalMesh& local, MPI_Comm comm)
-    : num_nodes_(local.mesh.num_nodes()), shared_(local.shared), send_(local.ghost_send), recv_(local.ghost_recv) {
+    : num_nodes_(local.mesh.num_nodes()),
+      shared_(local.shared),
+      send_(local.ghost_send),
+      recv_(local.ghost_recv),
+      only_send_(local.ghost_only_send),
+      only_recv_(local.ghost_only_recv) {
   MPI_Comm_dup(comm, &comm_);
   std::vector<std::pair<Index, std::pair<int, Index>>> entries;  // (node, (rank, source))
   for (int i = 0; i < shared_.num_ranks(); ++i)
@@ -23,7 +30,8 @@ Halo::Halo(const LocalMesh& local, MPI_Comm comm)
       entries.push_back({shared_.nodes[p], {shared_.ranks[i], p}});
   for (Index n : shared_.nodes) entries.push_back({n, {local.rank, -1}});
   std::sort(entries.begin(), entries.end());
-  entries.erase(std::unique(entries.begin(), entries.end()), entries.end());  // own entry once per node
+  entries.erase(std::unique(entries.begin(), entries.end()),
+                entries.end());  // own entry once per node
   for (const auto& [node, source] : entries) {
     if (combine_node_.empty() || combine_node_.back() != node) {
       combine_node_.push_back(node);
@@ -41,13 +49,13 @@ Halo::~Halo() {
 
 void Halo::check(std::span<const double> values, int components, Pending expected) const {
   SHATTER_REQUIRE(components >= 1 && values.size() == static_cast<size_t>(num_nodes_) * components,
-                  "Halo: nodal array of " << values.size() << " doubles for " << num_nodes_ << " nodes x "
-                                          << components << " components");
+                  "Halo: nodal array of " << values.size() << " doubles for " << num_nodes_
+                                          << " nodes x " << components << " components");
   SHATTER_REQUIRE(pending_ == expected, "Halo: begin/end calls out of order");
 }
 
-void Halo::post(const NodeExchange& out, const NodeExchange& in, std::span<const double> values, int components,
-                int tag) {
+void Halo::post(const NodeExchange& out, const NodeExchange& in, std::span<const double> values,
+                int components, int tag) {
   const size_t c = components;
   send_buffer_.resize(out.nodes.size() * c);
   recv_buffer_.resize(in.nodes.size() * c);
@@ -55,11 +63,13 @@ void Halo::post(const NodeExchange& out, const NodeExchange& in, std::span<const
     std::copy_n(values.data() + out.nodes[p] * c, c, send_buffer_.data() + p * c);
   requests_.resize(out.ranks.size() + in.ranks.size());
   for (int i = 0; i < in.num_ranks(); ++i)
-    MPI_Irecv(recv_buffer_.data() + in.offsets[i] * c, static_cast<int>((in.offsets[i + 1] - in.offsets[i]) * c),
-              MPI_DOUBLE, in.ranks[i], tag, comm_, &requests_[i]);
+    MPI_Irecv(recv_buffer_.data() + in.offsets[i] * c,
+              static_cast<int>((in.offsets[i + 1] - in.offsets[i]) * c), MPI_DOUBLE, in.ranks[i],
+              tag, comm_, &requests_[i]);
   for (int i = 0; i < out.num_ranks(); ++i)
-    MPI_Isend(send_buffer_.data() + out.offsets[i] * c, static_cast<int>((out.offsets[i + 1] - out.offsets[i]) * c),
-              MPI_DOUBLE, out.ranks[i], tag, comm_, &requests_[in.ranks.size() + i]);
+    MPI_Isend(send_buffer_.data() + out.offsets[i] * c,
+              static_cast<int>((out.offsets[i + 1] - out.offsets[i]) * c), MPI_DOUBLE, out.ranks[i],
+              tag, comm_, &requests_[in.ranks.size() + i]);
 }
 
 void Halo::wait() {
@@ -95,27 +105,33 @@ void Halo::sum_nodal(std::span<double> values, int components) {
   end_sum(values, components);
 }
 
-void Halo::sum_nodal(std::span<Vec3> values) { sum_nodal(as_doubles(values), 3); }
+void Halo::sum_nodal(std::span<Vec3> values) {
+  sum_nodal(as_doubles(values), 3);
+}
 
-void Halo::begin_update(std::span<const double> values, int components) {
+void Halo::begin_update(std::span<const double> values, int components, GhostCopies copies) {
   check(values, components, Pending::none);
-  post(send_, recv_, values, components, kUpdateTag);
+  post(sends(copies), receives(copies), values, components, kUpdateTag);
   pending_ = Pending::update;
+  pending_copies_ = copies;
 }
 
 void Halo::end_update(std::span<double> values, int components) {
   check(values, components, Pending::update);
   wait();
   const size_t c = components;
-  for (size_t p = 0; p < recv_.nodes.size(); ++p)
-    std::copy_n(recv_buffer_.data() + p * c, c, values.data() + recv_.nodes[p] * c);
+  const NodeExchange& in = receives(pending_copies_);
+  for (size_t p = 0; p < in.nodes.size(); ++p)
+    std::copy_n(recv_buffer_.data() + p * c, c, values.data() + in.nodes[p] * c);
 }
 
-void Halo::update_ghosts(std::span<double> values, int components) {
-  begin_update(values, components);
+void Halo::update_ghosts(std::span<double> values, int components, GhostCopies copies) {
+  begin_update(values, components, copies);
   end_update(values, components);
 }
 
-void Halo::update_ghosts(std::span<Vec3> values) { update_ghosts(as_doubles(values), 3); }
+void Halo::update_ghosts(std::span<Vec3> values, GhostCopies copies) {
+  update_ghosts(as_doubles(values), 3, copies);
+}
 
 }  // namespace shatter

@@ -15,6 +15,12 @@
 
 namespace shatter {
 
+/// Which copies a ghost update refreshes.
+enum class GhostCopies {
+  all,         ///< every node held here and owned by another rank
+  ghost_only,  ///< only nodes that no owned element uses (LocalMesh::node_touched == 0)
+};
+
 /// Exchanges nodal arrays of one LocalMesh. Nodal arrays are laid out
 /// node-major: values[n*components + c] is component c of local node n, and
 /// hold exactly mesh.num_nodes() * components doubles.
@@ -30,7 +36,10 @@ namespace shatter {
 /// update_ghosts fills them.
 ///
 /// Ghost update (update_ghosts): every node held here and owned by another
-/// rank (LocalMesh::node_owner) receives the owner's value, bit for bit.
+/// rank (LocalMesh::node_owner) receives the owner's value, bit for bit; with
+/// GhostCopies::ghost_only only the nodes that no owned element uses do, which
+/// is all the owner-computes scheme needs (docs/parallel.md): a touched node
+/// has its whole element star here and integrates itself.
 ///
 /// One exchange at a time per Halo: a begin_* must be followed by its end_*
 /// before the next begin_*. Between begin and end the caller may not change
@@ -55,33 +64,45 @@ class Halo {
   void sum_nodal(std::span<double> values, int components);
   void sum_nodal(std::span<Vec3> values);
 
-  /// Post the sends of owned values to the ranks holding copies, and the receives.
-  void begin_update(std::span<const double> values, int components);
-  /// Wait, then overwrite every node owned elsewhere with its owner's value.
+  /// Post the sends of owned values to the ranks holding those `copies`, and the receives.
+  void begin_update(std::span<const double> values, int components,
+                    GhostCopies copies = GhostCopies::all);
+  /// Wait, then overwrite the copies chosen in begin_update with their owners' values.
   void end_update(std::span<double> values, int components);
   /// begin_update + end_update.
-  void update_ghosts(std::span<double> values, int components);
-  void update_ghosts(std::span<Vec3> values);
+  void update_ghosts(std::span<double> values, int components,
+                     GhostCopies copies = GhostCopies::all);
+  void update_ghosts(std::span<Vec3> values, GhostCopies copies = GhostCopies::all);
 
   /// Bytes this rank sends in one sum / one update of `components` doubles per node.
-  std::size_t sum_bytes(int components) const { return shared_.nodes.size() * components * sizeof(double); }
-  std::size_t update_bytes(int components) const {
-    return send_.nodes.size() * components * sizeof(double);
+  std::size_t sum_bytes(int components) const {
+    return shared_.nodes.size() * components * sizeof(double);
+  }
+  std::size_t update_bytes(int components, GhostCopies copies = GhostCopies::all) const {
+    return sends(copies).nodes.size() * components * sizeof(double);
   }
   /// Messages this rank sends per sum / per update.
   int sum_messages() const { return shared_.num_ranks(); }
-  int update_messages() const { return send_.num_ranks(); }
+  int update_messages(GhostCopies copies = GhostCopies::all) const {
+    return sends(copies).num_ranks();
+  }
 
  private:
   enum class Pending { none, sum, update };
   void check(std::span<const double> values, int components, Pending expected) const;
-  void post(const NodeExchange& out, const NodeExchange& in, std::span<const double> values, int components,
-            int tag);
+  void post(const NodeExchange& out, const NodeExchange& in, std::span<const double> values,
+            int components, int tag);
   void wait();
+  const NodeExchange& sends(GhostCopies copies) const {
+    return copies == GhostCopies::all ? send_ : only_send_;
+  }
+  const NodeExchange& receives(GhostCopies copies) const {
+    return copies == GhostCopies::all ? recv_ : only_recv_;
+  }
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   Index num_nodes_ = 0;
-  NodeExchange shared_, send_, recv_;
+  NodeExchange shared_, send_, recv_, only_send_, only_recv_;
   // Combination plan of the sum: shared node combine_node_[j] adds, in rank
   // order, the sources combine_source_[combine_offsets_[j] .. [j+1]): an
   // index into shared_.nodes (a neighbour's partial, at the same position in
@@ -90,6 +111,7 @@ class Halo {
   std::vector<double> send_buffer_, recv_buffer_;
   std::vector<MPI_Request> requests_;
   Pending pending_ = Pending::none;
+  GhostCopies pending_copies_ = GhostCopies::all;
 };
 
 }  // namespace shatter

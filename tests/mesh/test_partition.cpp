@@ -38,7 +38,8 @@ Mesh permuted(const Mesh& m, std::vector<Index>& elem_perm) {
   std::iota(node_perm.begin(), node_perm.end(), 0);
   std::reverse(node_perm.begin(), node_perm.end());
   elem_perm.resize(ne);
-  for (Index e = 0; e < ne; ++e) elem_perm[e] = static_cast<Index>((static_cast<int64_t>(e) * 7919) % ne);
+  for (Index e = 0; e < ne; ++e)
+    elem_perm[e] = static_cast<Index>((static_cast<int64_t>(e) * 7919) % ne);
   std::vector<Index> new_of(nn);
   for (Index i = 0; i < nn; ++i) new_of[node_perm[i]] = i;
   Mesh p;
@@ -122,7 +123,8 @@ TEST(Subdomain, OwnedElementsAndOneGhostLayer) {
         if (part[e] == r) touched.insert(mesh.element(e), mesh.element(e) + k);
       std::set<GlobalId> owned, ghost;
       for (Index e = 0; e < ne; ++e) {
-        const bool uses = std::any_of(mesh.element(e), mesh.element(e) + k, [&](Index n) { return touched.count(n); });
+        const bool uses = std::any_of(mesh.element(e), mesh.element(e) + k,
+                                      [&](Index n) { return touched.count(n); });
         if (part[e] == r) {
           owned.insert(mesh.elem_gid[e]);
         } else if (uses) {
@@ -142,8 +144,8 @@ TEST(Subdomain, OwnedElementsAndOneGhostLayer) {
 
       // Canonical order, and each local element is the global one.
       EXPECT_TRUE(std::is_sorted(lm.elem_gid.begin(), lm.elem_gid.end()));
-      EXPECT_TRUE(std::adjacent_find(lm.node_gid.begin(), lm.node_gid.end(), std::greater_equal<>()) ==
-                  lm.node_gid.end());
+      EXPECT_TRUE(std::adjacent_find(lm.node_gid.begin(), lm.node_gid.end(),
+                                     std::greater_equal<>()) == lm.node_gid.end());
       std::map<GlobalId, Index> global_elem, global_node;
       for (Index e = 0; e < ne; ++e) global_elem[mesh.elem_gid[e]] = e;
       for (Index n = 0; n < mesh.num_nodes(); ++n) global_node[mesh.node_gid[n]] = n;
@@ -189,7 +191,9 @@ TEST(Subdomain, ExchangeListsAgreeBetweenRanks) {
   for (int r = 0; r < parts; ++r) locals.push_back(extract_subdomain(mesh, part, r));
   auto list = [&](const NodeExchange& x, int q, const LocalMesh& l) {
     const auto it = std::find(x.ranks.begin(), x.ranks.end(), q);
-    return it == x.ranks.end() ? std::vector<GlobalId>{} : gids_of(x.nodes_of(static_cast<int>(it - x.ranks.begin())), l.mesh);
+    return it == x.ranks.end()
+               ? std::vector<GlobalId>{}
+               : gids_of(x.nodes_of(static_cast<int>(it - x.ranks.begin())), l.mesh);
   };
   Index ghost_only = 0;
   for (int r = 0; r < parts; ++r) {
@@ -197,10 +201,18 @@ TEST(Subdomain, ExchangeListsAgreeBetweenRanks) {
     for (int q = 0; q < parts; ++q) {
       if (q == r) continue;
       EXPECT_EQ(list(lr.shared, q, lr), list(locals[q].shared, r, locals[q])) << r << " <-> " << q;
-      EXPECT_EQ(list(lr.ghost_send, q, lr), list(locals[q].ghost_recv, r, locals[q])) << r << " -> " << q;
+      EXPECT_EQ(list(lr.ghost_send, q, lr), list(locals[q].ghost_recv, r, locals[q]))
+          << r << " -> " << q;
+      EXPECT_EQ(list(lr.ghost_only_send, q, lr), list(locals[q].ghost_only_recv, r, locals[q]))
+          << r << " -> " << q;
     }
     // Every node owned elsewhere is received exactly once, from its owner.
-    std::vector<int> received(lr.mesh.num_nodes(), 0);
+    std::vector<int> received(lr.mesh.num_nodes(), 0), received_only(lr.mesh.num_nodes(), 0);
+    for (int i = 0; i < lr.ghost_only_recv.num_ranks(); ++i)
+      for (Index n : lr.ghost_only_recv.nodes_of(i)) {
+        ++received_only[n];
+        EXPECT_EQ(lr.node_owner[n], lr.ghost_only_recv.ranks[i]);
+      }
     for (int i = 0; i < lr.ghost_recv.num_ranks(); ++i)
       for (Index n : lr.ghost_recv.nodes_of(i)) {
         ++received[n];
@@ -208,6 +220,7 @@ TEST(Subdomain, ExchangeListsAgreeBetweenRanks) {
       }
     for (Index n = 0; n < lr.mesh.num_nodes(); ++n) {
       EXPECT_EQ(received[n], lr.owns_node(n) ? 0 : 1);
+      EXPECT_EQ(received_only[n], lr.node_touched[n] ? 0 : 1);
       ghost_only += !lr.node_touched[n];
     }
   }
@@ -222,7 +235,8 @@ TEST(Subdomain, DoesNotDependOnTheGlobalMeshOrder) {
   std::vector<int> other_part(part.size());
   for (size_t e = 0; e < part.size(); ++e) other_part[e] = part[elem_perm[e]];
   for (int r = 0; r < 3; ++r) {
-    const LocalMesh a = extract_subdomain(mesh, part, r), b = extract_subdomain(other, other_part, r);
+    const LocalMesh a = extract_subdomain(mesh, part, r),
+                    b = extract_subdomain(other, other_part, r);
     EXPECT_EQ(a.mesh.conn, b.mesh.conn);
     EXPECT_EQ(a.mesh.elem_gid, b.mesh.elem_gid);
     EXPECT_EQ(a.mesh.node_gid, b.mesh.node_gid);
@@ -232,5 +246,6 @@ TEST(Subdomain, DoesNotDependOnTheGlobalMeshOrder) {
     EXPECT_EQ(a.shared.nodes, b.shared.nodes);
     EXPECT_EQ(a.ghost_send.nodes, b.ghost_send.nodes);
     EXPECT_EQ(a.ghost_recv.nodes, b.ghost_recv.nodes);
+    EXPECT_EQ(a.ghost_only_send.nodes, b.ghost_only_send.nodes);
   }
 }
