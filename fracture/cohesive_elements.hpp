@@ -44,10 +44,16 @@ struct Insertion {
   /// copies position, velocity (and displacement) from the parent, then
   /// recomputes the lumped masses of the parent and the copy from their
   /// element stars (mass of a node = sum of its elements' contributions), so
-  /// that mass and momentum are unchanged.
+  /// that mass and momentum are unchanged. Element reference constants do not
+  /// change (copies keep the reference position), and an element coloring
+  /// stays conflict-free (splitting only removes shared nodes).
   std::vector<std::array<Index, 2>> new_nodes;
   /// New crack faces: (element, local face) for both sides of every inserted
-  /// facet, oriented outward of the element (nodes: face_nodes(mesh, e, face)).
+  /// facet, oriented outward of the element (nodes: face_nodes(mesh, e, face),
+  /// read after the call). Splitting also renames nodes of older surface
+  /// triangles, so when new_nodes is not empty a contact surface must be
+  /// rebuilt from the mesh rather than appended to; a facet whose two sides
+  /// still share all their nodes is not open and is no contact face.
   std::vector<std::array<Index, 2>> crack_faces;
   /// The new cohesive elements are [first_cohesive, cohesive.size()).
   Index first_cohesive = 0;
