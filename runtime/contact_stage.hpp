@@ -21,8 +21,9 @@ class ContactStage {
   DcrResult apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                   std::span<const double> inv_mass);
 
-  /// New free surface (crack faces) joins the contact surface.
-  void add_faces(std::span<const SurfaceTriangle> faces) { add_triangles(surface_, faces); }
+  /// Rebuild the surface after fracture split nodes: crack faces whose sides
+  /// no longer share nodes join it, and older triangles get the new node ids.
+  void rebuild(const Mesh& mesh) { surface_ = build_contact_surface(mesh); }
 
   const ContactSurface& surface() const { return surface_; }
   /// Seconds spent in the search and in DCR so far.

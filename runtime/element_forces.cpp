@@ -38,7 +38,8 @@ void ElementForces::rebuild() {
   block_worst_.assign(nblocks, -1);
 }
 
-ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int) const {
+ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int,
+                                         std::span<double> stress6) const {
   const Mesh& mesh = model_.mesh;
   const Index ne = mesh.num_elements();
   const Index* conn = mesh.conn.data();
@@ -74,6 +75,7 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
         J = out.J;
         h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
       }
+      if (!stress6.empty()) element_cauchy_stress6(model_, x, e, stress6.data() + 6 * static_cast<size_t>(e));
       // J <= 0 (or NaN) makes the wave speed NaN; the caller diagnoses it.
       dt = std::min(dt, h / m.wave_speed(J > 0 ? J : 1.0));
       if (worse(J, minJ)) {
@@ -106,26 +108,32 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
   return res;
 }
 
+void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e, double* o) {
+  const Mesh& mesh = model.mesh;
+  const NeoHookean& m = model.materials[mesh.elem_material[e]];
+  const Index* c = mesh.element(e);
+  Mat3 s = Mat3::Zero();
+  if (mesh.order == 1) {
+    s = m.cauchy_stress(tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], model.tet4_Dm_inv[e]));
+  } else {
+    Tet10Nodes xe;
+    for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
+    for (int q = 0; q < 4; ++q) s += 0.25 * m.cauchy_stress(xe * model.tet10_ref[e].dNdX[q]);
+  }
+  o[0] = s(0, 0), o[1] = s(1, 1), o[2] = s(2, 2), o[3] = s(1, 2), o[4] = s(0, 2), o[5] = s(0, 1);
+}
+
 void element_stresses(const Model& model, std::span<const Vec3> x, std::vector<double>& stress6,
                       std::vector<double>& von_mises_out) {
-  const Mesh& mesh = model.mesh;
-  const Index ne = mesh.num_elements();
+  const Index ne = model.mesh.num_elements();
   stress6.resize(static_cast<size_t>(ne) * 6);
   von_mises_out.resize(ne);
   tbb::parallel_for(tbb::blocked_range<Index>(0, ne, 1024), [&](const tbb::blocked_range<Index>& r) {
     for (Index e = r.begin(); e < r.end(); ++e) {
-      const NeoHookean& m = model.materials[mesh.elem_material[e]];
-      const Index* c = mesh.element(e);
-      Mat3 s = Mat3::Zero();
-      if (mesh.order == 1) {
-        s = m.cauchy_stress(tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], model.tet4_Dm_inv[e]));
-      } else {
-        Tet10Nodes xe;
-        for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
-        for (int q = 0; q < 4; ++q) s += 0.25 * m.cauchy_stress(xe * model.tet10_ref[e].dNdX[q]);
-      }
       double* o = stress6.data() + 6 * static_cast<size_t>(e);
-      o[0] = s(0, 0), o[1] = s(1, 1), o[2] = s(2, 2), o[3] = s(1, 2), o[4] = s(0, 2), o[5] = s(0, 1);
+      element_cauchy_stress6(model, x, e, o);
+      Mat3 s;
+      s << o[0], o[5], o[4], o[5], o[1], o[3], o[4], o[3], o[2];
       von_mises_out[e] = von_mises(s);
     }
   });

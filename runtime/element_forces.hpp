@@ -31,8 +31,10 @@ class ElementForces {
   /// Recolor after a topology change (node splitting).
   void rebuild();
 
-  /// f_int = dE/dx at positions x (overwrites f_int, size = nodes).
-  ElementLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int) const;
+  /// f_int = dE/dx at positions x (overwrites f_int, size = nodes). When
+  /// stress6 is not empty, also writes each element's Cauchy stress there
+  /// (6 per element, as element_cauchy_stress6) for the fracture check.
+  ElementLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int, std::span<double> stress6 = {}) const;
 
   int num_colors() const { return coloring_.num_colors(); }
 
@@ -43,8 +45,11 @@ class ElementForces {
   mutable std::vector<Index> block_worst_;
 };
 
-/// Cauchy stress (6 components xx yy zz yz xz xy, averaged over the element's
-/// points) and von Mises stress of every element at positions x.
+/// Cauchy stress of element e at positions x, averaged over its points, as 6
+/// Voigt components xx yy zz yz xz xy (Pa) written to out[0..5].
+void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e, double* out);
+
+/// element_cauchy_stress6 and the von Mises stress of every element.
 void element_stresses(const Model& model, std::span<const Vec3> x, std::vector<double>& stress6,
                       std::vector<double>& von_mises_out);
 

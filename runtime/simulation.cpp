@@ -1,12 +1,15 @@
 #include "runtime/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <cstdio>
 #include <sstream>
 
 #include "kernels/error.hpp"
 #include "runtime/contact_stage.hpp"
 #include "runtime/field_output.hpp"
+#include "runtime/fracture_stage.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
 
@@ -52,6 +55,11 @@ Simulation::Simulation(Model& model, RunOptions options)
     contact_inv_mass_.resize(n);
     for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
+  if (model_.scene.fracture_enabled()) {
+    fracture_ = std::make_unique<FractureStage>(model_);
+    stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
+  }
+  ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
   compute_forces();
   update_ledger();
   total0_ = ledger_.total();
@@ -72,8 +80,13 @@ double Simulation::next_dt() const {
 
 void Simulation::compute_forces() {
   const auto t0 = std::chrono::steady_clock::now();
-  last_elements_ = elements_.compute(x_, f_int_);
+  last_elements_ = elements_.compute(x_, f_int_, stress6_);
   element_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (fracture_) {
+    const CohesiveEnergy ce = fracture_->add_forces(x_, f_int_);
+    ledger_.cohesive_stored = ce.stored;
+    ledger_.cohesive_dissipated = ce.dissipated;
+  }
   stable_dt_ = last_elements_.stable_dt;
   if (!(last_elements_.min_jacobian > 0)) {
     const Index e = last_elements_.worst_element;
@@ -158,7 +171,53 @@ void Simulation::step() {
   ledger_.external_work += gravity_work + reaction_work;
   time_ += dt;
   ++step_;
+  if (fracture_) apply_fracture();
   update_ledger();
+}
+
+void Simulation::apply_fracture() {
+  fracture_->release();
+  const Insertion ins = fracture_->check_and_insert(x_, stress6_);
+  ledger_.cohesive_elements = fracture_->cohesive_count();
+  if (ins.new_nodes.empty()) return;
+  grow_nodes(ins.new_nodes);
+  // The split nodes' masses and forces changed: recompute the accelerations
+  // that the next half step uses (the velocities were copied, so momentum is
+  // unchanged).
+  compute_forces();
+  if (contact_) contact_->rebuild(model_.mesh);
+}
+
+void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {
+  Mesh& mesh = model_.mesh;
+  ++mesh.revision;
+  const Index n = mesh.num_nodes();
+  for (auto* a : {&x_, &v_, &a_, &f_int_, &f_ext_, &model_.bc_velocity, &model_.initial_velocity}) a->resize(n);
+  model_.bc_mask.resize(n);
+  model_.mass.resize(n);
+  inv_mass_.resize(n);
+  if (contact_) contact_inv_mass_.resize(n);
+  std::vector<Index> touched;
+  for (const auto& [child, parent] : new_nodes) {
+    x_[child] = x_[parent];
+    v_[child] = v_[parent];
+    model_.bc_mask[child] = model_.bc_mask[parent];
+    model_.bc_velocity[child] = model_.bc_velocity[parent];
+    model_.initial_velocity[child] = model_.initial_velocity[parent];
+    if (model_.bc_mask[child]) {
+      bc_nodes_.push_back(child);
+      reaction_.push_back(Vec3::Zero());
+    }
+    touched.push_back(child);
+    touched.push_back(parent);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  recompute_node_masses(model_, touched);
+  for (Index i : touched) {
+    inv_mass_[i] = 1.0 / model_.mass[i];
+    if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
+  }
 }
 
 void Simulation::update_ledger() {
@@ -182,6 +241,11 @@ void Simulation::update_ledger() {
 
 void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
+  std::optional<Fragments> frags;
+  if (fracture_) {
+    frags = fracture_->fragments(x_, v_, model_.mass);
+    ledger_.fragments = frags->count();
+  }
   const Ledger& l = ledger_;
   *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
             << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
@@ -218,6 +282,11 @@ void Simulation::write_outputs(bool fields) {
     f.stress = stress;
     f.von_mises = vm;
     f.body = mesh.elem_body;
+    std::vector<int> fragment_id;
+    if (frags) {
+      fragment_id.assign(frags->elem_fragment.begin(), frags->elem_fragment.end());
+      f.fragment = fragment_id;
+    }
     fields_->write(mesh, f);
   }
 }
@@ -258,8 +327,23 @@ long Simulation::run() {
   progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   fields_.reset();
-  if (!opt_.out_dir.empty()) write_summary(wall);
+  if (!opt_.out_dir.empty()) {
+    if (fracture_) write_fragments();
+    write_summary(wall);
+  }
   return step_;
+}
+
+void Simulation::write_fragments() {
+  const Fragments frags = fracture_->fragments(x_, v_, model_.mass);
+  CsvWriter out(opt_.out_dir / "fragments.csv",
+                {"id", "mass", "volume", "cx", "cy", "cz", "vx", "vy", "vz", "elements"});
+  for (Index k = 0; k < frags.count(); ++k) {
+    const FragmentStats& s = frags.stats[k];
+    out << static_cast<long>(k) << s.mass << s.volume << s.centre.x() << s.centre.y() << s.centre.z()
+        << s.velocity.x() << s.velocity.y() << s.velocity.z() << static_cast<long>(s.elements);
+    out.end_row();
+  }
 }
 
 void Simulation::write_summary(double wall) {
@@ -296,6 +380,7 @@ void Simulation::write_summary(double wall) {
   j.add("cohesive_elements", l.cohesive_elements);
   j.add("fragments", l.fragments);
   j.add("contact_capped_steps", l.contact_capped_steps);
+  if (fracture_) j.add("fracture_check_time", fracture_->check_seconds());
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());
     j.add("contact_dcr_time", contact_->dcr_seconds());

@@ -8,6 +8,7 @@
 //   4. a(n+1) = M^-1 (f_ext - f_int);  v(n+1) = v(n+1/2) + dt/2 a(n+1)
 //   5. fracture (when a material has a fracture block)
 //   6. ledger, output, progress
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -23,6 +24,7 @@ namespace shatter {
 class FieldWriter;
 class CsvWriter;
 class ContactStage;
+class FractureStage;
 
 struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
@@ -70,6 +72,7 @@ class Simulation {
   const Model& model() const { return model_; }
   double element_loop_seconds() const { return element_seconds_; }
   const ContactStage* contact() const { return contact_.get(); }
+  const FractureStage* fracture() const { return fracture_.get(); }
 
  private:
   void compute_forces();
@@ -94,8 +97,13 @@ class Simulation {
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
   std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
+  std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block
+  std::vector<double> stress6_;             ///< per element Cauchy stress for the facet check (fracture only)
   std::unique_ptr<FieldWriter> fields_;
   std::unique_ptr<CsvWriter> history_, bodies_;
+  void apply_fracture();
+  void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
+  void write_fragments();
 };
 
 }  // namespace shatter

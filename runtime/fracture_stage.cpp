@@ -1,0 +1,47 @@
+#include "runtime/fracture_stage.hpp"
+
+#include <chrono>
+
+#include "fracture/facet_criterion.hpp"
+#include "kernels/tet4.hpp"
+
+namespace shatter {
+
+FractureStage::FractureStage(Model& model) : model_(model), topology_(build_topology(model.mesh)) {
+  const Mesh& mesh = model.mesh;
+  std::vector<double> h_min(model.scene.materials.size(), HUGE_VAL);
+  for (Index e = 0; e < mesh.num_elements(); ++e) {
+    const Index* c = mesh.element(e);
+    const auto& X = mesh.reference;
+    h_min[mesh.elem_material[e]] =
+        std::min(h_min[mesh.elem_material[e]], tet_min_altitude(X[c[0]], X[c[1]], X[c[2]], X[c[3]]));
+  }
+  for (size_t m = 0; m < model.scene.materials.size(); ++m) {
+    const MaterialSpec& ms = model.scene.materials[m];
+    if (ms.fracture)
+      laws_.emplace_back(make_cohesive_law(ms.fracture->strength, ms.fracture->energy, ms.fracture->beta,
+                                           ms.young / h_min[m]));
+    else
+      laws_.emplace_back(std::nullopt);
+  }
+}
+
+CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3> f_int) {
+  if (cohesive_.size() == 0) return {};
+  return cohesive_forces(model_.mesh, topology_, cohesive_, laws_, x, f_int);
+}
+
+Insertion FractureStage::check_and_insert(std::span<const Vec3> x, std::span<const double> stress6) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_);
+  check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (critical.empty()) return {};
+  return insert_cohesive_elements(model_.mesh, topology_, cohesive_, critical);
+}
+
+Index FractureStage::release() {
+  if (cohesive_.size() == 0) return 0;
+  return release_debonded(model_.mesh, topology_, cohesive_, laws_);
+}
+
+}  // namespace shatter
