@@ -28,7 +28,8 @@ const std::array<Vec3, kCohesivePoints>& facet_points() {
   return p;
 }
 
-void refresh_side_nodes(const Mesh& mesh, const Topology& topo, CohesiveElements& coh, Index first) {
+void refresh_side_nodes(const Mesh& mesh, const Topology& topo, CohesiveElements& coh,
+                        Index first) {
   const int k = mesh.order == 1 ? 3 : 6;
   coh.side_nodes.resize(static_cast<size_t>(coh.size()) * 2 * kSlots, -1);
   for (Index c = first; c < coh.size(); ++c)
@@ -45,14 +46,16 @@ Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements&
                                    std::span<const Index> facets) {
   const int k = mesh.order == 1 ? 3 : 6;
   std::vector<Index> sorted(facets.begin(), facets.end());
-  std::sort(sorted.begin(), sorted.end(), [&](Index a, Index b) { return topo.facet_gid[a] < topo.facet_gid[b]; });
+  std::sort(sorted.begin(), sorted.end(),
+            [&](Index a, Index b) { return topo.facet_gid[a] < topo.facet_gid[b]; });
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
 
   Insertion out;
   out.first_cohesive = coh.size();
   for (const Index f : sorted) {
     SHATTER_REQUIRE(topo.facet_state[f] == FacetState::intact && topo.is_interior(f),
-                    "insert_cohesive_elements: facet " << topo.facet_gid[f] << " is not an intact interior facet");
+                    "insert_cohesive_elements: facet " << topo.facet_gid[f]
+                                                       << " is not an intact interior facet");
     topo.facet_state[f] = FacetState::cohesive;
     const auto [e0, e1] = topo.facet_elem[f];
     const int face0 = topo.facet_face[f][0];
@@ -69,7 +72,8 @@ Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements&
       SHATTER_ASSERT(local[kSlots + j] >= 0);
     }
     const Vec3& X0 = mesh.reference[c0[local[0]]];
-    const Vec3 area_vector = 0.5 * (mesh.reference[c0[local[1]]] - X0).cross(mesh.reference[c0[local[2]]] - X0);
+    const Vec3 area_vector =
+        0.5 * (mesh.reference[c0[local[1]]] - X0).cross(mesh.reference[c0[local[2]]] - X0);
     coh.facet.push_back(f);
     coh.side_local.insert(coh.side_local.end(), local.begin(), local.end());
     coh.area.push_back(area_vector.norm());
@@ -84,8 +88,8 @@ Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements&
   return out;
 }
 
-CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& coh, FractureLaws laws,
-                               std::span<const Vec3> x, std::span<Vec3> f_int) {
+CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& coh,
+                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int) {
   const int k = mesh.order == 1 ? 3 : 6;
   const Index nc = coh.size();
   // Blocks of elements: local forces computed in parallel into a buffer that
@@ -97,38 +101,39 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
   CohesiveEnergy total;
   for (Index first = 0; first < nc; first += kBlock) {
     const Index last = std::min(nc, first + kBlock);
-    tbb::parallel_for(tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
-      for (Index c = r.begin(); c != r.end(); ++c) {
-        const CohesiveLaw* law_ptr = facet_law(mesh, topo, laws, coh.facet[c]);
-        SHATTER_ASSERT(law_ptr);  // insertion happens only where the criterion has a law
-        const CohesiveLaw& law = *law_ptr;
-        const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
-        const Index* side1 = side0 + kSlots;
-        // Mid-surface normal from the corners, pointing from side 0 to side 1.
-        std::array<Vec3, 3> mid;
-        for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
-        const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
-        Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
-        std::fill(f, f + 2 * k, Vec3::Zero());
-        CohesiveEnergy& energy = local_energy[c - first];
-        energy = CohesiveEnergy{};
-        for (int q = 0; q < kCohesivePoints; ++q) {
-          const std::array<double, 6> N = facet_shape(facet_points()[q], k);
-          Vec3 opening = Vec3::Zero();
-          for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
-          double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
-          const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
-          delta_max = t.delta_max;
-          const double w = coh.area[c] / kCohesivePoints;
-          for (int j = 0; j < k; ++j) {
-            f[k + j] += (w * N[j]) * t.traction;
-            f[j] -= (w * N[j]) * t.traction;
+    tbb::parallel_for(
+        tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
+          for (Index c = r.begin(); c != r.end(); ++c) {
+            const CohesiveLaw* law_ptr = facet_law(mesh, topo, laws, coh.facet[c]);
+            SHATTER_ASSERT(law_ptr);  // insertion happens only where the criterion has a law
+            const CohesiveLaw& law = *law_ptr;
+            const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+            const Index* side1 = side0 + kSlots;
+            // Mid-surface normal from the corners, pointing from side 0 to side 1.
+            std::array<Vec3, 3> mid;
+            for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
+            const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
+            Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
+            std::fill(f, f + 2 * k, Vec3::Zero());
+            CohesiveEnergy& energy = local_energy[c - first];
+            energy = CohesiveEnergy{};
+            for (int q = 0; q < kCohesivePoints; ++q) {
+              const std::array<double, 6> N = facet_shape(facet_points()[q], k);
+              Vec3 opening = Vec3::Zero();
+              for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
+              double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
+              const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
+              delta_max = t.delta_max;
+              const double w = coh.area[c] / kCohesivePoints;
+              for (int j = 0; j < k; ++j) {
+                f[k + j] += (w * N[j]) * t.traction;
+                f[j] -= (w * N[j]) * t.traction;
+              }
+              energy.stored += w * t.stored;
+              energy.dissipated += w * t.dissipated;
+            }
           }
-          energy.stored += w * t.stored;
-          energy.dissipated += w * t.dissipated;
-        }
-      }
-    });
+        });
     for (Index c = first; c < last; ++c) {
       const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
       const Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
@@ -143,7 +148,8 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
   return total;
 }
 
-Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh, FractureLaws laws) {
+Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,
+                       FractureLaws laws) {
   Index freed = 0;
   for (Index c = 0; c < coh.size(); ++c) {
     const Index f = coh.facet[c];

@@ -91,6 +91,7 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
 /// Mark free the cohesive facets whose every quadrature point has opened past
 /// delta_c (no traction left; the two sides now belong to separate fragments
 /// unless joined elsewhere). Returns the number of facets freed.
-Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive, FractureLaws laws);
+Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive,
+                       FractureLaws laws);
 
 }  // namespace shatter

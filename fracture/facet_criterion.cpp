@@ -28,12 +28,13 @@ Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Inde
 }
 
 std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
-                                   std::span<const double> stress, int stress_size, FractureLaws laws) {
+                                   std::span<const double> stress, int stress_size,
+                                   FractureLaws laws) {
   SHATTER_REQUIRE(stress_size == 6 || stress_size == 9,
                   "critical_facets: stress_size must be 6 or 9, got " << stress_size);
   SHATTER_REQUIRE(stress.size() >= static_cast<size_t>(mesh.num_elements()) * stress_size,
-                  "critical_facets: " << stress.size() << " stress values for " << mesh.num_elements()
-                                      << " elements");
+                  "critical_facets: " << stress.size() << " stress values for "
+                                      << mesh.num_elements() << " elements");
   const Index nf = topo.num_facets();
   // One flag per facet, then a serial gather: the output is independent of
   // how the range is split among threads.
@@ -47,15 +48,16 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
       const std::array<Index, 6> fn = face_nodes(mesh, e0, topo.facet_face[f][0]);
       const Vec3 area_vector = (x[fn[1]] - x[fn[0]]).cross(x[fn[2]] - x[fn[0]]);
       const Vec3 n = area_vector.normalized();
-      const Mat3 sigma =
-          0.5 * (element_cauchy_stress(stress, stress_size, e0) + element_cauchy_stress(stress, stress_size, e1));
+      const Mat3 sigma = 0.5 * (element_cauchy_stress(stress, stress_size, e0) +
+                                element_cauchy_stress(stress, stress_size, e1));
       breaks[f] = facet_effective_traction(sigma, n, law->beta) >= law->sigma_c;
     }
   });
   std::vector<Index> out;
   for (Index f = 0; f < nf; ++f)
     if (breaks[f]) out.push_back(f);
-  std::sort(out.begin(), out.end(), [&](Index a, Index b) { return topo.facet_gid[a] < topo.facet_gid[b]; });
+  std::sort(out.begin(), out.end(),
+            [&](Index a, Index b) { return topo.facet_gid[a] < topo.facet_gid[b]; });
   return out;
 }
 

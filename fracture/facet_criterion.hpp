@@ -31,6 +31,7 @@ Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Inde
 /// sorted by Topology::facet_gid, the canonical insertion order, and does not
 /// depend on the number of threads.
 std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
-                                   std::span<const double> stress, int stress_size, FractureLaws laws);
+                                   std::span<const double> stress, int stress_size,
+                                   FractureLaws laws);
 
 }  // namespace shatter

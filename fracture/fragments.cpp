@@ -49,7 +49,8 @@ Fragments find_fragments(const Mesh& mesh, const Topology& topo, std::span<const
   std::vector<Index> roots;
   for (Index e = 0; e < ne; ++e)
     if (parent[e] == e) roots.push_back(e);
-  std::sort(roots.begin(), roots.end(), [&](Index a, Index b) { return root_min[a] < root_min[b]; });
+  std::sort(roots.begin(), roots.end(),
+            [&](Index a, Index b) { return root_min[a] < root_min[b]; });
   std::vector<Index> root_id(ne, -1);
   for (size_t i = 0; i < roots.size(); ++i) root_id[roots[i]] = static_cast<Index>(i);
 

@@ -9,17 +9,17 @@ namespace shatter {
 
 /// Statistics of one fragment (SI units).
 struct FragmentStats {
-  double mass = 0;                 ///< sum of its nodal masses, kg
-  double volume = 0;               ///< sum of its elements' current volumes, m^3
-  Vec3 centre = Vec3::Zero();      ///< mass-weighted mean position, m
-  Vec3 velocity = Vec3::Zero();    ///< momentum / mass, m/s
-  Index elements = 0;              ///< element count
+  double mass = 0;               ///< sum of its nodal masses, kg
+  double volume = 0;             ///< sum of its elements' current volumes, m^3
+  Vec3 centre = Vec3::Zero();    ///< mass-weighted mean position, m
+  Vec3 velocity = Vec3::Zero();  ///< momentum / mass, m/s
+  Index elements = 0;            ///< element count
 };
 
 /// Fragment id of every element and statistics per fragment.
 struct Fragments {
-  std::vector<Index> elem_fragment;   ///< [e]
-  std::vector<FragmentStats> stats;   ///< [fragment]
+  std::vector<Index> elem_fragment;  ///< [e]
+  std::vector<FragmentStats> stats;  ///< [fragment]
   Index count() const { return static_cast<Index>(stats.size()); }
 };
 

@@ -47,7 +47,8 @@ struct CohesiveLaw {
 };
 
 /// sigma_c (Pa), Gc (J/m^2), beta (-), penalty k_p (Pa/m).
-inline CohesiveLaw make_cohesive_law(double sigma_c, double fracture_energy, double beta, double penalty) {
+inline CohesiveLaw make_cohesive_law(double sigma_c, double fracture_energy, double beta,
+                                     double penalty) {
   return {sigma_c, 2.0 * fracture_energy / sigma_c, beta, penalty};
 }
 
@@ -67,8 +68,8 @@ struct CohesiveTraction {
 /// Ortiz-Pandolfi traction for opening `opening` = x(side 1) - x(side 0) (m),
 /// unit normal `n` pointing from side 0 to side 1, previous state
 /// `delta_max` (m). Pure; the caller stores the returned state.
-inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& opening, const Vec3& n,
-                                          double delta_max) {
+inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& opening,
+                                          const Vec3& n, double delta_max) {
   const double delta_n = opening.dot(n);
   const Vec3 delta_s = opening - delta_n * n;
   const double beta2 = law.beta * law.beta;
@@ -90,7 +91,8 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
     out.traction += law.penalty * delta_n * n;
     out.stored += 0.5 * law.penalty * delta_n * delta_n;
   }
-  out.dissipated = out.delta_max >= law.delta_c ? law.fracture_energy() : 0.5 * law.sigma_c * out.delta_max;
+  out.dissipated =
+      out.delta_max >= law.delta_c ? law.fracture_energy() : 0.5 * law.sigma_c * out.delta_max;
   return out;
 }
 

@@ -11,7 +11,9 @@ namespace shatter {
 
 namespace {
 
-int face_node_count(const Mesh& mesh) { return mesh.order == 1 ? 3 : 6; }
+int face_node_count(const Mesh& mesh) {
+  return mesh.order == 1 ? 3 : 6;
+}
 
 int local_index(const Mesh& mesh, Index e, Index n) {
   const Index* c = mesh.element(e);
@@ -64,9 +66,9 @@ Topology build_topology(const Mesh& mesh, GlobalId split_gid_base) {
   for (size_t r = 0; r < records.size();) {
     size_t end = r + 1;
     while (end < records.size() && records[end].key == records[r].key) ++end;
-    SHATTER_REQUIRE(end - r <= 2, "build_topology: face of element " << mesh.elem_gid[records[r].elem]
-                                                                     << " is shared by " << end - r
-                                                                     << " elements (non-manifold mesh)");
+    SHATTER_REQUIRE(end - r <= 2, "build_topology: face of element "
+                                      << mesh.elem_gid[records[r].elem] << " is shared by "
+                                      << end - r << " elements (non-manifold mesh)");
     const Index f = topo.num_facets();
     std::array<Index, 2> elems = {records[r].elem, -1};
     std::array<std::int8_t, 2> faces = {static_cast<std::int8_t>(records[r].face), -1};
@@ -82,16 +84,19 @@ Topology build_topology(const Mesh& mesh, GlobalId split_gid_base) {
     topo.facet_face.push_back(faces);
     topo.facet_state.push_back(end - r == 2 ? FacetState::intact : FacetState::free);
     topo.facet_gid.push_back(4 * mesh.elem_gid[elems[0]] + faces[0]);
-    for (size_t s = r; s < end; ++s) topo.elem_facet[static_cast<size_t>(records[s].elem) * 4 + records[s].face] = f;
+    for (size_t s = r; s < end; ++s)
+      topo.elem_facet[static_cast<size_t>(records[s].elem) * 4 + records[s].face] = f;
     r = end;
   }
   if (split_gid_base < 0)
-    split_gid_base = mesh.node_gid.empty() ? 0 : *std::max_element(mesh.node_gid.begin(), mesh.node_gid.end());
+    split_gid_base =
+        mesh.node_gid.empty() ? 0 : *std::max_element(mesh.node_gid.begin(), mesh.node_gid.end());
   topo.split_gid_base = split_gid_base;
   return topo;
 }
 
-std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, std::span<const Index> facets) {
+std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo,
+                                              std::span<const Index> facets) {
   const int k = mesh.nodes_per_element();
   // Stars changed during this call; the CSR is rebuilt once at the end.
   std::unordered_map<Index, std::vector<Index>> stars;
@@ -108,7 +113,8 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, 
   std::vector<int> label;
   std::vector<Index> queue;
   for (const Index f : facets) {
-    const std::array<Index, 6> nodes = face_nodes(mesh, topo.facet_elem[f][0], topo.facet_face[f][0]);
+    const std::array<Index, 6> nodes =
+        face_nodes(mesh, topo.facet_elem[f][0], topo.facet_face[f][0]);
     for (int j = 0; j < face_node_count(mesh); ++j) {
       const Index n = nodes[j];
       const std::vector<Index> star = star_of(n);
@@ -129,8 +135,10 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, 
           const Index e = star[s];
           for (int i = 0; i < 4; ++i) {
             const Index g = topo.elem_facet[static_cast<size_t>(e) * 4 + i];
-            if (topo.facet_state[g] != FacetState::intact || !face_contains(mesh, e, i, n)) continue;
-            const Index other = topo.facet_elem[g][0] == e ? topo.facet_elem[g][1] : topo.facet_elem[g][0];
+            if (topo.facet_state[g] != FacetState::intact || !face_contains(mesh, e, i, n))
+              continue;
+            const Index other =
+                topo.facet_elem[g][0] == e ? topo.facet_elem[g][1] : topo.facet_elem[g][0];
             const Index t = position(other);
             SHATTER_ASSERT(t < m && star[t] == other);
             if (label[t] < 0) {
@@ -157,7 +165,8 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, 
       }
       std::vector<int> order(num_components);
       std::iota(order.begin(), order.end(), 0);
-      std::sort(order.begin(), order.end(), [&](int a, int b) { return comp_min[a] < comp_min[b]; });
+      std::sort(order.begin(), order.end(),
+                [&](int a, int b) { return comp_min[a] < comp_min[b]; });
 
       stars[n] = comps[order[0]];
       for (int c = 1; c < num_components; ++c) {
@@ -168,7 +177,8 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, 
         mesh.node_body.push_back(mesh.node_body[n]);
         mesh.node_gid.push_back(topo.split_gid_base + 10 * comp_min[comp] +
                                 local_index(mesh, comp_min_elem[comp], n) + 1);
-        for (const Index e : comps[comp]) mesh.conn[static_cast<size_t>(e) * k + local_index(mesh, e, n)] = copy;
+        for (const Index e : comps[comp])
+          mesh.conn[static_cast<size_t>(e) * k + local_index(mesh, e, n)] = copy;
         stars[copy] = comps[comp];
         created.push_back({copy, n});
       }

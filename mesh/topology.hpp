@@ -81,7 +81,8 @@ inline std::span<const Index> node_star(const Mesh& mesh, Index n) {
 /// Updates conn, reference, node_gid, node_body and the node -> element CSR.
 /// Returns (new node, parent node) pairs in creation order; a parent may be a
 /// node created earlier in the same call.
-std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo, std::span<const Index> facets);
+std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo,
+                                              std::span<const Index> facets);
 
 /// Faces of the current surface: every face of every element whose facet is
 /// not intact (boundary faces and both sides of crack facets), oriented

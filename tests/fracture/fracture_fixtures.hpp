@@ -37,6 +37,8 @@ inline std::vector<double> lumped_masses(const Mesh& mesh, double rho) {
   return m;
 }
 
-inline std::vector<std::optional<CohesiveLaw>> one_law(const CohesiveLaw& law) { return {law}; }
+inline std::vector<std::optional<CohesiveLaw>> one_law(const CohesiveLaw& law) {
+  return {law};
+}
 
 }  // namespace shatter::test

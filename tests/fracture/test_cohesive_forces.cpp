@@ -24,7 +24,8 @@ namespace {
 Mesh two_tets() {
   Mesh m;
   m.order = 1;
-  m.reference = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.3, 1), Vec3(0.3, 0.2, -1)};
+  m.reference = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.3, 1),
+                 Vec3(0.3, 0.2, -1)};
   m.node_gid = {1, 2, 3, 4, 5};
   m.node_body = {0, 0, 0, 0, 0};
   m.conn = {0, 1, 2, 3, 0, 2, 1, 4};
@@ -120,7 +121,7 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
 
   std::vector<Vec3> x = m.reference, v(m.num_nodes(), Vec3::Zero());
   std::vector<double> mass = test::lumped_masses(m, mat.density);
-  const double v_pull = 0.01;  // m/s, each apex: slow against c = 115 m/s
+  const double v_pull = 0.01;                // m/s, each apex: slow against c = 115 m/s
   const double dt = 1.0e-4, damping = 20.0;  // 1/s, mass-proportional, on the free nodes
   std::vector<Vec3> f, f_coh;
   std::vector<double> stress;
@@ -135,11 +136,13 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
     stress.assign(9 * m.num_elements(), 0.0);
     for (Index e = 0; e < m.num_elements(); ++e) {
       const Index* c = m.element(e);
-      const Tet4Reference ref = tet4_reference(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]],
-                                               m.reference[c[3]]);
-      const Tet4Force fe = tet4_internal_force(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv, ref.volume, mat);
+      const Tet4Reference ref = tet4_reference(m.reference[c[0]], m.reference[c[1]],
+                                               m.reference[c[2]], m.reference[c[3]]);
+      const Tet4Force fe =
+          tet4_internal_force(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv, ref.volume, mat);
       for (int a = 0; a < 4; ++a) f[c[a]] += fe.f.col(a);
-      const Mat3 sigma = mat.cauchy_stress(tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv));
+      const Mat3 sigma = mat.cauchy_stress(
+          tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref.Dm_inv));
       Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(stress.data() + 9 * e) = sigma;
     }
     energy = cohesive_forces(m, t, coh, laws, x, f_coh);
@@ -206,7 +209,8 @@ TEST(CohesiveForces, PrescribedMixedOpeningWorkIsGcTimesAreaTet4AndTet10) {
       const Vec3 direction = std::cos(angle) * n + std::sin(angle) / law.beta * s;
       CohesiveEnergy energy;
       const double work = prescribed_opening_work(m, law, direction, 2400, energy);
-      EXPECT_CLOSE(work, 0.5 * law.fracture_energy(), 1e-8, 0) << "order " << m.order << " angle " << angle;
+      EXPECT_CLOSE(work, 0.5 * law.fracture_energy(), 1e-8, 0)
+          << "order " << m.order << " angle " << angle;
       EXPECT_CLOSE(energy.dissipated, 0.5 * law.fracture_energy(), 1e-12, 0);
     }
 }
@@ -242,7 +246,8 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
   std::vector<Vec3> x = m.reference;
   // A mixed opening with a rotation of side 1, then a compressed one.
   for (double sign : {1.0, -1.0}) {
-    for (Index n = 5; n < 8; ++n) x[n] = m.reference[n] + 1e-3 * Vec3(0.3 * n, -0.2, sign * (0.5 + 0.1 * n));
+    for (Index n = 5; n < 8; ++n)
+      x[n] = m.reference[n] + 1e-3 * Vec3(0.3 * n, -0.2, sign * (0.5 + 0.1 * n));
     std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
     cohesive_forces(m, t, coh, laws, x, f);
     Vec3 sum = Vec3::Zero();

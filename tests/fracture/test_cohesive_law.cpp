@@ -14,13 +14,16 @@ namespace {
 const Vec3 kNormal = Vec3(1, 2, 2) / 3.0;
 const Vec3 kShear = Vec3(2, -2, 1) / 3.0;  // unit, orthogonal to kNormal
 
-CohesiveLaw test_law(double beta) { return make_cohesive_law(3.0e6, 40.0, beta, 1.0e15); }
+CohesiveLaw test_law(double beta) {
+  return make_cohesive_law(3.0e6, 40.0, beta, 1.0e15);
+}
 
 /// Work of the traction along the straight path lambda -> lambda * direction,
 /// 0 <= lambda <= lambda_end, midpoint rule on n panels (the integrand
 /// T . direction is piecewise linear in lambda, so the rule is exact up to the
 /// panel containing delta_c), carrying the irreversible state along.
-double path_work(const CohesiveLaw& law, const Vec3& direction, double lambda_end, int n, double& delta_max) {
+double path_work(const CohesiveLaw& law, const Vec3& direction, double lambda_end, int n,
+                 double& delta_max) {
   double work = 0;
   const double h = lambda_end / n;
   for (int i = 0; i < n; ++i) {
@@ -47,7 +50,9 @@ TEST(CohesiveLaw, ModeIEnvelope) {
   // Past delta_c nothing is left, also on the way back.
   const CohesiveTraction past = cohesive_traction(law, 1.5 * law.delta_c * kNormal, kNormal, 0.0);
   EXPECT_EQ(past.traction.norm(), 0.0);
-  EXPECT_EQ(cohesive_traction(law, 0.5 * law.delta_c * kNormal, kNormal, past.delta_max).traction.norm(), 0.0);
+  EXPECT_EQ(
+      cohesive_traction(law, 0.5 * law.delta_c * kNormal, kNormal, past.delta_max).traction.norm(),
+      0.0);
   // Zero opening after insertion: no traction, no state.
   EXPECT_EQ(cohesive_traction(law, Vec3::Zero(), kNormal, 0.0).traction.norm(), 0.0);
 }
@@ -62,7 +67,8 @@ TEST(CohesiveLaw, WorkOfSeparationIsGcForEveryMixity) {
       // Panels aligned with delta_c: the rule is exact, so round-off only.
       const double work = path_work(law, dir, 1.25 * law.delta_c, 100000, delta_max);
       EXPECT_CLOSE(work, law.fracture_energy(), 1e-10, 0) << "beta " << beta << " angle " << angle;
-      const CohesiveTraction end = cohesive_traction(law, 1.25 * law.delta_c * dir, kNormal, delta_max);
+      const CohesiveTraction end =
+          cohesive_traction(law, 1.25 * law.delta_c * dir, kNormal, delta_max);
       EXPECT_CLOSE(end.dissipated, law.fracture_energy(), 1e-15, 0);
       EXPECT_EQ(end.stored, 0.0);
     }
@@ -111,12 +117,15 @@ TEST(CohesiveLaw, CompressionActsOnShearOnlyWithNormalPenalty) {
   const double delta = law.beta * ds;  // the normal part does not count
   EXPECT_CLOSE(t.delta_max, delta, 1e-15, 0);
   const double t_eff = cohesive_envelope(law, delta);
-  const Vec3 expected = t_eff / delta * law.beta * law.beta * ds * kShear + law.penalty * dn * kNormal;
+  const Vec3 expected =
+      t_eff / delta * law.beta * law.beta * ds * kShear + law.penalty * dn * kNormal;
   EXPECT_LT((t.traction - expected).norm(), 1e-13 * expected.norm());
   EXPECT_CLOSE(t.stored, 0.5 * t_eff * delta + 0.5 * law.penalty * dn * dn, 1e-13, 0);
   // Around the switch delta_n = 0 the traction is continuous.
-  const Vec3 a = cohesive_traction(law, 1e-12 * law.delta_c * kNormal + ds * kShear, kNormal, 0.0).traction;
-  const Vec3 b = cohesive_traction(law, -1e-12 * law.delta_c * kNormal + ds * kShear, kNormal, 0.0).traction;
+  const Vec3 a =
+      cohesive_traction(law, 1e-12 * law.delta_c * kNormal + ds * kShear, kNormal, 0.0).traction;
+  const Vec3 b =
+      cohesive_traction(law, -1e-12 * law.delta_c * kNormal + ds * kShear, kNormal, 0.0).traction;
   EXPECT_LT((a - b).norm(), 1e-6 * law.sigma_c);
 }
 

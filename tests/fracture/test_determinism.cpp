@@ -39,16 +39,21 @@ TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
       reference_facets = facets;
       EXPECT_GT(facets.size(), 50u);
       EXPECT_LT(facets.size(), static_cast<size_t>(t.num_facets()));
-      for (size_t i = 1; i < facets.size(); ++i) EXPECT_LT(t.facet_gid[facets[i - 1]], t.facet_gid[facets[i]]);
+      for (size_t i = 1; i < facets.size(); ++i)
+        EXPECT_LT(t.facet_gid[facets[i - 1]], t.facet_gid[facets[i]]);
       // The same set as a direct serial evaluation of the criterion.
       std::vector<GlobalId> direct, found;
       for (Index f = 0; f < t.num_facets(); ++f) {
         if (!t.is_interior(f)) continue;
         const auto [e0, e1] = t.facet_elem[f];
         const auto fn = face_nodes(m, e0, t.facet_face[f][0]);
-        const Vec3 n = (m.reference[fn[1]] - m.reference[fn[0]]).cross(m.reference[fn[2]] - m.reference[fn[0]]).normalized();
-        const Mat3 sigma = 0.5 * (element_cauchy_stress(stress, 6, e0) + element_cauchy_stress(stress, 6, e1));
-        if (facet_effective_traction(sigma, n, law.beta) >= law.sigma_c) direct.push_back(t.facet_gid[f]);
+        const Vec3 n = (m.reference[fn[1]] - m.reference[fn[0]])
+                           .cross(m.reference[fn[2]] - m.reference[fn[0]])
+                           .normalized();
+        const Mat3 sigma =
+            0.5 * (element_cauchy_stress(stress, 6, e0) + element_cauchy_stress(stress, 6, e1));
+        if (facet_effective_traction(sigma, n, law.beta) >= law.sigma_c)
+          direct.push_back(t.facet_gid[f]);
       }
       for (const Index f : facets) found.push_back(t.facet_gid[f]);
       std::sort(direct.begin(), direct.end());
@@ -69,7 +74,8 @@ TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
     CohesiveElements state = coh;
     std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
     tbb::task_arena arena(threads);
-    const CohesiveEnergy energy = arena.execute([&] { return cohesive_forces(m, t, state, laws, x, f); });
+    const CohesiveEnergy energy =
+        arena.execute([&] { return cohesive_forces(m, t, state, laws, x, f); });
     if (threads == 1) {
       reference_force = f;
       reference_energy = energy;

@@ -30,7 +30,8 @@ TEST(Fragmentation, StretchedBarKeepsEnergyAndMomentum) {
   std::vector<Tet4Reference> ref;
   for (Index e = 0; e < m.num_elements(); ++e) {
     const Index* c = m.element(e);
-    ref.push_back(tet4_reference(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]], m.reference[c[3]]));
+    ref.push_back(
+        tet4_reference(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]], m.reference[c[3]]));
   }
   auto lumped = [&] {
     std::vector<double> mass(m.num_nodes(), 0.0);
@@ -51,11 +52,13 @@ TEST(Fragmentation, StretchedBarKeepsEnergyAndMomentum) {
     elastic = 0;
     for (Index e = 0; e < m.num_elements(); ++e) {
       const Index* c = m.element(e);
-      const Tet4Force fe = tet4_internal_force(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref[e].Dm_inv, ref[e].volume, mat);
+      const Tet4Force fe = tet4_internal_force(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref[e].Dm_inv,
+                                               ref[e].volume, mat);
       for (int a = 0; a < 4; ++a) f[c[a]] += fe.f.col(a);
       elastic += fe.energy;
       const Mat3 F = tet4_deformation_gradient(x[c[0]], x[c[1]], x[c[2]], x[c[3]], ref[e].Dm_inv);
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(stress.data() + 9 * e) = mat.cauchy_stress(F);
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(stress.data() + 9 * e) =
+          mat.cauchy_stress(F);
     }
     cohesive = cohesive_forces(m, t, coh, laws, x, f);
   };
@@ -119,7 +122,9 @@ TEST(Fragmentation, StretchedBarKeepsEnergyAndMomentum) {
   }
   EXPECT_EQ(elements, m.num_elements());
   EXPECT_CLOSE(fragment_mass, mat.density * 0.3 * 0.05 * 0.05, 1e-12, 0);
-  std::printf("[ fragmentation ] %d elements, %d facets broken, %d fragments, energy0 %.6g J, "
-              "dissipated %.6g J, balance error %.3g\n",
-              m.num_elements(), insertions, fr.count(), energy0, cohesive.dissipated, (energy - energy0) / energy0);
+  std::printf(
+      "[ fragmentation ] %d elements, %d facets broken, %d fragments, energy0 %.6g J, "
+      "dissipated %.6g J, balance error %.3g\n",
+      m.num_elements(), insertions, fr.count(), energy0, cohesive.dissipated,
+      (energy - energy0) / energy0);
 }

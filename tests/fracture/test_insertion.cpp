@@ -85,8 +85,10 @@ bool connected_around(const Mesh& m, const Topology& t, Index n, Index a, Index 
 /// -1 per reversed one: a closed oriented surface gives 0 for every edge.
 /// Returns the number of unbalanced edges; `non_manifold` counts edges used by
 /// more than two faces.
-int unbalanced_surface_edges(const Mesh& m, const Topology& t, const Fragments& fr, int& non_manifold) {
-  std::map<std::array<GlobalId, 3>, std::array<int, 2>> edges;  // (fragment, lo, hi) -> (balance, uses)
+int unbalanced_surface_edges(const Mesh& m, const Topology& t, const Fragments& fr,
+                             int& non_manifold) {
+  std::map<std::array<GlobalId, 3>, std::array<int, 2>>
+      edges;  // (fragment, lo, hi) -> (balance, uses)
   for (const auto& [e, face] : surface_faces(m, t)) {
     const auto fn = face_nodes(m, e, face);
     for (int j = 0; j < 3; ++j) {
@@ -161,7 +163,8 @@ void random_insertions(int order, double element_size) {
     EXPECT_EQ(ins.crack_faces.size(), 2 * intact.size());
     apply_insertion(m, ins, s);
     // Some cohesive elements debond completely.
-    for (Index c = ins.first_cohesive; c < coh.size(); c += 3) t.facet_state[coh.facet[c]] = FacetState::free;
+    for (Index c = ins.first_cohesive; c < coh.size(); c += 3)
+      t.facet_state[coh.facet[c]] = FacetState::free;
     check_invariants(m, t, coh, s, mass0, p0, p_scale);
     const Fragments fr = find_fragments(m, t, s.x, s.v, s.mass);
     // Closed and oriented; not strictly edge-manifold while cracks are partial:
@@ -196,8 +199,8 @@ void random_insertions(int order, double element_size) {
   for (Index i = 0; i < fr.count(); ++i) {
     EXPECT_EQ(fr.stats[i].elements, 1);
     // Canonical numbering: fragment i holds the i-th smallest element global id.
-    const Index e = static_cast<Index>(std::find(fr.elem_fragment.begin(), fr.elem_fragment.end(), i) -
-                                       fr.elem_fragment.begin());
+    const Index e = static_cast<Index>(
+        std::find(fr.elem_fragment.begin(), fr.elem_fragment.end(), i) - fr.elem_fragment.begin());
     EXPECT_GT(m.elem_gid[e], previous);
     previous = m.elem_gid[e];
     EXPECT_CLOSE(fr.stats[i].mass, kRho * element_reference_volume(m, e), 1e-13, 0);
@@ -210,9 +213,13 @@ void random_insertions(int order, double element_size) {
 
 }  // namespace
 
-TEST(Insertion, RandomInsertionsTet4KeepInvariants) { random_insertions(1, 0.15); }
+TEST(Insertion, RandomInsertionsTet4KeepInvariants) {
+  random_insertions(1, 0.15);
+}
 
-TEST(Insertion, RandomInsertionsTet10KeepInvariants) { random_insertions(2, 0.3); }
+TEST(Insertion, RandomInsertionsTet10KeepInvariants) {
+  random_insertions(2, 0.3);
+}
 
 TEST(Insertion, NodeNamesAreDerivedFromTheStar) {
   Mesh m = test::box_mesh(0.3, 1);
@@ -250,7 +257,8 @@ TEST(Fragments, CutPiecesMoveRigidly) {
   Topology t = build_topology(m);
   auto left = [&](Index e) {
     const Index* c = m.element(e);
-    return (m.reference[c[0]] + m.reference[c[1]] + m.reference[c[2]] + m.reference[c[3]]).x() / 4 < 0.45;
+    return (m.reference[c[0]] + m.reference[c[1]] + m.reference[c[2]] + m.reference[c[3]]).x() / 4 <
+           0.45;
   };
   std::vector<Index> cut;
   for (Index f = 0; f < t.num_facets(); ++f)

@@ -29,7 +29,8 @@ void check_topology(const Mesh& m) {
     const auto [e0, e1] = t.facet_elem[f];
     // Every local face points away from its element.
     const Index* c = m.element(e0);
-    const Vec3 centre = 0.25 * (m.reference[c[0]] + m.reference[c[1]] + m.reference[c[2]] + m.reference[c[3]]);
+    const Vec3 centre =
+        0.25 * (m.reference[c[0]] + m.reference[c[1]] + m.reference[c[2]] + m.reference[c[3]]);
     const auto n0 = face_nodes(m, e0, t.facet_face[f][0]);
     EXPECT_GT(facet_area_vector(m, e0, t.facet_face[f][0]).dot(m.reference[n0[0]] - centre), 0);
     EXPECT_EQ(t.elem_facet[4 * e0 + t.facet_face[f][0]], f);
@@ -50,7 +51,8 @@ void check_topology(const Mesh& m) {
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     EXPECT_EQ(a, b);
-    const Vec3 s0 = facet_area_vector(m, e0, t.facet_face[f][0]), s1 = facet_area_vector(m, e1, t.facet_face[f][1]);
+    const Vec3 s0 = facet_area_vector(m, e0, t.facet_face[f][0]),
+               s1 = facet_area_vector(m, e1, t.facet_face[f][1]);
     EXPECT_LT((s0 + s1).norm(), 1e-12 * s0.norm());
   }
   EXPECT_EQ(4 * m.num_elements(), 2 * interior + boundary);
@@ -59,9 +61,13 @@ void check_topology(const Mesh& m) {
 
 }  // namespace
 
-TEST(Topology, Tet4BoxFacets) { check_topology(test::box_mesh(0.2, 1)); }
+TEST(Topology, Tet4BoxFacets) {
+  check_topology(test::box_mesh(0.2, 1));
+}
 
-TEST(Topology, Tet10BoxFacets) { check_topology(test::box_mesh(0.3, 2)); }
+TEST(Topology, Tet10BoxFacets) {
+  check_topology(test::box_mesh(0.3, 2));
+}
 
 TEST(Topology, NodeStarsMatchConnectivity) {
   const Mesh m = test::box_mesh(0.25, 1);
