@@ -46,6 +46,11 @@ struct Topology {
   std::vector<FacetState> facet_state;
   std::vector<GlobalId> facet_gid;
   std::vector<Index> elem_facet;
+  // With MPI, a facet between a held element and one that is not held (the
+  // outer faces of the ghost layer) looks like a boundary facet here; its id
+  // is then not the global one. Only facets with both elements held (every
+  // facet of an owned element) are meaningful across ranks.
+
   /// Names of nodes created by splitting start past this value: it must be at
   /// least the largest global node id of the whole (all-rank) input mesh.
   GlobalId split_gid_base = 0;
