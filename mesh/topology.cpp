@@ -184,7 +184,10 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo,
       }
     }
   }
-  if (!created.empty()) mesh.build_node_elements();
+  if (!created.empty()) {
+    mesh.build_node_elements();
+    ++mesh.revision;
+  }
   return created;
 }
 

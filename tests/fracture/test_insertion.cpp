@@ -159,8 +159,10 @@ void random_insertions(int order, double element_size) {
       if (t.facet_state[f] == FacetState::intact) intact.push_back(f);
     std::shuffle(intact.begin(), intact.end(), rng);
     intact.resize(std::min<size_t>(intact.size(), t.num_facets() / 40));
+    const std::uint64_t revision = m.revision;
     const Insertion ins = insert_cohesive_elements(m, t, coh, intact);
     EXPECT_EQ(ins.crack_faces.size(), 2 * intact.size());
+    EXPECT_EQ(m.revision, revision + (ins.new_nodes.empty() ? 0 : 1));
     apply_insertion(m, ins, s);
     // Some cohesive elements debond completely.
     for (Index c = ins.first_cohesive; c < coh.size(); c += 3)
