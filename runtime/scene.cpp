@@ -76,7 +76,7 @@ class Reader {
     }
   }
   std::string string(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar() || n.Tag() == "?" && n.as<std::string>().empty()) fail(key, "a string", n);
+    if (!n.IsScalar() || n.Scalar().empty()) fail(key, "a non-empty string", n);
     return n.as<std::string>();
   }
   Vec3 vec3(const YAML::Node& n, const std::string& key) const {

@@ -141,7 +141,7 @@ void Simulation::step() {
   if (contact_) {
     x_prev_ = x_;
     parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
-    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_);
+    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt);
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
@@ -189,9 +189,7 @@ void Simulation::apply_fracture() {
 }
 
 void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {
-  Mesh& mesh = model_.mesh;
-  ++mesh.revision;
-  const Index n = mesh.num_nodes();
+  const Index n = model_.mesh.num_nodes();
   for (auto* a : {&x_, &v_, &a_, &f_int_, &f_ext_, &model_.bc_velocity, &model_.initial_velocity}) a->resize(n);
   model_.bc_mask.resize(n);
   model_.mass.resize(n);
