@@ -40,7 +40,7 @@ std::uint64_t morton_code(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return code;
 }
 
-MeshPermutation reorder_for_locality(Mesh& mesh) {
+MeshPermutation reorder_for_locality(Mesh& mesh, GlobalIdPolicy gids) {
   const Index n = mesh.num_nodes(), ne = mesh.num_elements();
   const int k = mesh.nodes_per_element();
   MeshPermutation perm;
@@ -91,6 +91,10 @@ MeshPermutation reorder_for_locality(Mesh& mesh) {
   permute(mesh.reference, perm.node_new_of_old);
   permute(mesh.node_gid, perm.node_new_of_old);
   permute(mesh.node_body, perm.node_new_of_old);
+  if (gids == GlobalIdPolicy::renumber) {
+    std::sort(mesh.node_gid.begin(), mesh.node_gid.end());
+    std::sort(mesh.elem_gid.begin(), mesh.elem_gid.end());
+  }
   mesh.build_node_elements();
   ++mesh.revision;
   return perm;

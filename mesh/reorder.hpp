@@ -23,12 +23,22 @@ struct MeshPermutation {
 /// [lo, hi]; points outside are clamped. Equal points give equal codes.
 std::uint64_t morton_code(const Vec3& p, const Vec3& lo, const Vec3& hi);
 
+/// What happens to the global ids when reordering.
+enum class GlobalIdPolicy {
+  keep,      ///< ids move with their entities (Gmsh tags stay attached)
+  renumber,  ///< the same set of ids, handed out in ascending order along the
+             ///< new local order: ascending gid == new order, so anything that
+             ///< sorts by gid (extract_subdomain's canonical order) inherits
+             ///< the locality on every rank
+};
+
 /// Reorder elements along the Morton curve of their reference centroids
 /// (ties keep the old order) and nodes by first use in the new element order
 /// (nodes used by no element keep their relative order, at the end).
-/// Every per-node and per-element array of the mesh is permuted (global ids
-/// move with their entities, so output and cross-rank naming are unchanged)
-/// and node_elem is rebuilt. Deterministic; O((n + e) log e).
-MeshPermutation reorder_for_locality(Mesh& mesh);
+/// Every per-node and per-element array of the mesh is permuted, global ids
+/// per `gids`, node_elem is rebuilt and revision bumped. Deterministic;
+/// O((n + e) log e). Apply to the global mesh before partitioning with
+/// GlobalIdPolicy::renumber, or to one rank's mesh with keep.
+MeshPermutation reorder_for_locality(Mesh& mesh, GlobalIdPolicy gids = GlobalIdPolicy::keep);
 
 }  // namespace shatter

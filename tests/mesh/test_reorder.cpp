@@ -3,6 +3,7 @@
 // volumes), orders elements along the Morton curve and nodes by first use.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <numeric>
 
@@ -127,4 +128,17 @@ TEST(Reorder, MortonCodeInterleavesAxes) {
   EXPECT_EQ(morton_code(Vec3(0, 1.5 * cell, 0), lo, hi), 2u);
   EXPECT_EQ(morton_code(Vec3(0, 0, 1.5 * cell), lo, hi), 4u);
   EXPECT_EQ(morton_code(Vec3(2, -1, 0.5), lo, hi), morton_code(Vec3(1, 0, 0.5), lo, hi));  // clamped
+}
+
+TEST(Reorder, RenumberedGlobalIdsFollowTheNewOrder) {
+  const Mesh before = scrambled_box(4);
+  Mesh after = before;
+  const MeshPermutation perm = reorder_for_locality(after, GlobalIdPolicy::renumber);
+  EXPECT_TRUE(std::is_sorted(after.node_gid.begin(), after.node_gid.end()));
+  EXPECT_TRUE(std::is_sorted(after.elem_gid.begin(), after.elem_gid.end()));
+  std::vector<GlobalId> a = before.elem_gid, b = after.elem_gid;
+  std::sort(a.begin(), a.end());
+  EXPECT_EQ(a, b);  // the same set of ids
+  for (Index v = 0; v < before.num_nodes(); ++v)
+    EXPECT_EQ(after.reference[perm.node_new_of_old[v]], before.reference[v]);
 }
