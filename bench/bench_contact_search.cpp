@@ -52,14 +52,15 @@ Scene colliding_bodies(double element_size) {
   ball.center = Vec3(2.05, 0.3, 0);
   append_mesh(m, mesh_shape(ball, 1, 0, "bench"));
   Scene s{build_contact_surface(m), m.reference, m.reference};
-  for (Index n = 0; n < m.num_nodes(); ++n) s.x_new[n] += Vec3(m.node_body[n] == 0 ? 0.05 : -0.05, 0, 0);
+  for (Index n = 0; n < m.num_nodes(); ++n)
+    s.x_new[n] += Vec3(m.node_body[n] == 0 ? 0.05 : -0.05, 0, 0);
   return s;
 }
 
 /// Surface of a unit cube, each face an m x m grid of squares split in two
 /// triangles (12 m^2 triangles, appended to tris), rotated by R about its centre c.
-void add_cube(Scene& s, std::vector<SurfaceTriangle>& tris, int m, const Vec3& c, const Mat3& R, const Vec3& motion,
-              int body) {
+void add_cube(Scene& s, std::vector<SurfaceTriangle>& tris, int m, const Vec3& c, const Mat3& R,
+              const Vec3& motion, int body) {
   std::vector<Index> id((m + 1) * (m + 1) * (m + 1), -1);
   auto node = [&](int i, int j, int k) {
     Index& n = id[(i * (m + 1) + j) * (m + 1) + k];
@@ -104,9 +105,11 @@ Scene pile_of_cubes(int triangles) {
   std::vector<SurfaceTriangle> tris;
   for (int c = 0; c < cubes; ++c) {
     const int i = c % side, j = (c / side) % side, k = c / (side * side);
-    const Mat3 R = (Eigen::AngleAxisd(jitter(rng), Vec3::UnitZ()) * Eigen::AngleAxisd(jitter(rng), Vec3::UnitX()))
+    const Mat3 R = (Eigen::AngleAxisd(jitter(rng), Vec3::UnitZ()) *
+                    Eigen::AngleAxisd(jitter(rng), Vec3::UnitX()))
                        .toRotationMatrix();
-    add_cube(s, tris, m, Vec3(1.03 * i + jitter(rng), 1.03 * j + jitter(rng), 1.03 * k), R, Vec3(0, 0, -0.01), c);
+    add_cube(s, tris, m, Vec3(1.03 * i + jitter(rng), 1.03 * j + jitter(rng), 1.03 * k), R,
+             Vec3(0, 0, -0.01), c);
   }
   s.surface = make_contact_surface(tris);
   return s;
@@ -135,9 +138,11 @@ Scene fragment_cloud(int triangles) {
       s.x_new.push_back(x + motion);
     }
     // outward orientation depends on the sign of the random tet's volume
-    const Vec3 &x0 = s.x_old[base], &x1 = s.x_old[base + 1], &x2 = s.x_old[base + 2], &x3 = s.x_old[base + 3];
+    const Vec3 &x0 = s.x_old[base], &x1 = s.x_old[base + 1], &x2 = s.x_old[base + 2],
+               &x3 = s.x_old[base + 3];
     const bool positive = (x1 - x0).cross(x2 - x0).dot(x3 - x0) > 0;
-    for (const auto& f : {std::array{0, 2, 1}, std::array{0, 1, 3}, std::array{0, 3, 2}, std::array{1, 2, 3}}) {
+    for (const auto& f :
+         {std::array{0, 2, 1}, std::array{0, 1, 3}, std::array{0, 3, 2}, std::array{1, 2, 3}}) {
       std::array<Index, 3> n = {base + f[0], base + f[1], base + f[2]};
       if (!positive) std::swap(n[1], n[2]);
       tris.push_back({n, t});
@@ -152,7 +157,9 @@ const Scene& scene(int kind, int size) {
   static std::map<std::pair<int, int>, Scene> cache;
   auto it = cache.find({kind, size});
   if (it != cache.end()) return it->second;
-  Scene s = kind == 0 ? colliding_bodies(size / 1000.0) : kind == 1 ? pile_of_cubes(size) : fragment_cloud(size);
+  Scene s = kind == 0   ? colliding_bodies(size / 1000.0)
+            : kind == 1 ? pile_of_cubes(size)
+                        : fragment_cloud(size);
   return cache.emplace(std::pair{kind, size}, std::move(s)).first->second;
 }
 
@@ -188,7 +195,9 @@ struct HashGrid {
       for (auto j = lo[1]; j <= hi[1]; ++j)
         for (auto k = lo[2]; k <= hi[2]; ++k) f(i, j, k);
   }
-  size_t bytes() const { return offsets.capacity() * sizeof(std::uint32_t) + ids.capacity() * sizeof(Index); }
+  size_t bytes() const {
+    return offsets.capacity() * sizeof(std::uint32_t) + ids.capacity() * sizeof(Index);
+  }
 };
 
 HashGrid build_hash_grid(std::span<const Box> boxes, double h, const Vec3& origin) {
@@ -199,7 +208,8 @@ HashGrid build_hash_grid(std::span<const Box> boxes, double h, const Vec3& origi
   for (const Box& b : boxes) g.for_cells(b, [&](auto, auto, auto) { ++entries; });
   g.table = 2 * entries + 1;
   g.offsets.assign(g.table + 1, 0);
-  for (const Box& b : boxes) g.for_cells(b, [&](auto i, auto j, auto k) { ++g.offsets[g.bucket(i, j, k) + 1]; });
+  for (const Box& b : boxes)
+    g.for_cells(b, [&](auto i, auto j, auto k) { ++g.offsets[g.bucket(i, j, k) + 1]; });
   for (size_t t = 0; t < g.table; ++t) g.offsets[t + 1] += g.offsets[t];
   g.ids.resize(entries);
   std::vector<std::uint32_t> fill(g.offsets.begin(), g.offsets.end() - 1);
@@ -214,7 +224,8 @@ void query_hash_grid(const HashGrid& g, std::span<const Box> boxes, const Box& q
     const size_t t = g.bucket(i, j, k);
     for (auto p = g.offsets[t]; p < g.offsets[t + 1]; ++p) {
       const Box& b = boxes[g.ids[p]];
-      if (boxes_overlap(q, b) && g.cell(q.lo.cwiseMax(b.lo)) == std::array{i, j, k}) report(g.ids[p]);
+      if (boxes_overlap(q, b) && g.cell(q.lo.cwiseMax(b.lo)) == std::array{i, j, k})
+        report(g.ids[p]);
     }
   });
 }
@@ -235,23 +246,24 @@ ContactPairs hash_grid_candidates(const ContactSurface& s, const SweptBoxes& b, 
   bytes = tri.bytes() + edge.bytes() + bytes_of(b);
   tbb::enumerable_thread_specific<ContactPairs> buffers;
   const size_t nv = b.vertices.size(), ne = b.edges.size();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + ne, 256), [&](const tbb::blocked_range<size_t>& r) {
-    ContactPairs& out = buffers.local();
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      if (k < nv) {
-        const auto v = static_cast<Index>(k);
-        query_hash_grid(tri, b.triangles, b.vertices[k], [&](Index t) {
-          if (auto p = vertex_face_pair(s, v, t)) out.push_back(*p);
-        });
-      } else {
-        const auto e = static_cast<Index>(k - nv);
-        query_hash_grid(edge, b.edges, b.edges[e], [&](Index f) {
-          if (e < f)
-            if (auto p = edge_edge_pair(s, e, f)) out.push_back(*p);
-        });
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + ne, 256),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      ContactPairs& out = buffers.local();
+                      for (size_t k = r.begin(); k != r.end(); ++k) {
+                        if (k < nv) {
+                          const auto v = static_cast<Index>(k);
+                          query_hash_grid(tri, b.triangles, b.vertices[k], [&](Index t) {
+                            if (auto p = vertex_face_pair(s, v, t)) out.push_back(*p);
+                          });
+                        } else {
+                          const auto e = static_cast<Index>(k - nv);
+                          query_hash_grid(edge, b.edges, b.edges[e], [&](Index f) {
+                            if (e < f)
+                              if (auto p = edge_edge_pair(s, e, f)) out.push_back(*p);
+                          });
+                        }
+                      }
+                    });
   ContactPairs pairs;
   for (const auto& buf : buffers) pairs.insert(pairs.end(), buf.begin(), buf.end());
   canonicalize(pairs);
@@ -274,7 +286,8 @@ std::vector<CgalBox> cgal_boxes(const std::vector<Box>& boxes) {
 
 template <class Tag>
 ContactPairs cgal_candidates(const ContactSurface& s, const SweptBoxes& b, size_t& bytes) {
-  std::vector<CgalBox> tri = cgal_boxes(b.triangles), edge = cgal_boxes(b.edges), vert = cgal_boxes(b.vertices);
+  std::vector<CgalBox> tri = cgal_boxes(b.triangles), edge = cgal_boxes(b.edges),
+                       vert = cgal_boxes(b.vertices);
   // box_self_intersection_d works on an internal copy of the edge boxes; a
   // CGAL pipeline would make its boxes from the positions directly, so our
   // swept boxes are not counted
@@ -282,12 +295,14 @@ ContactPairs cgal_candidates(const ContactSurface& s, const SweptBoxes& b, size_
   tbb::enumerable_thread_specific<ContactPairs> buffers;
   CGAL::box_intersection_d<Tag>(vert.begin(), vert.end(), tri.begin(), tri.end(),
                                 [&](const CgalBox& v, const CgalBox& t) {
-                                  if (auto p = vertex_face_pair(s, v.info(), t.info())) buffers.local().push_back(*p);
+                                  if (auto p = vertex_face_pair(s, v.info(), t.info()))
+                                    buffers.local().push_back(*p);
                                 });
-  CGAL::box_self_intersection_d<Tag>(edge.begin(), edge.end(), [&](const CgalBox& e, const CgalBox& f) {
-    const Index a = std::min(e.info(), f.info()), c = std::max(e.info(), f.info());
-    if (auto p = edge_edge_pair(s, a, c)) buffers.local().push_back(*p);
-  });
+  CGAL::box_self_intersection_d<Tag>(
+      edge.begin(), edge.end(), [&](const CgalBox& e, const CgalBox& f) {
+        const Index a = std::min(e.info(), f.info()), c = std::max(e.info(), f.info());
+        if (auto p = edge_edge_pair(s, a, c)) buffers.local().push_back(*p);
+      });
   ContactPairs pairs;
   for (const auto& buf : buffers) pairs.insert(pairs.end(), buf.begin(), buf.end());
   canonicalize(pairs);
@@ -309,8 +324,12 @@ void bench_search(benchmark::State& state, int kind, int size, Method method, in
         pairs = find_candidates(sc.surface, boxes);
         break;
       }
-      case Brute: pairs = find_candidates_brute_force(sc.surface, boxes); break;
-      case Hash: pairs = hash_grid_candidates(sc.surface, boxes, bytes); break;
+      case Brute:
+        pairs = find_candidates_brute_force(sc.surface, boxes);
+        break;
+      case Hash:
+        pairs = hash_grid_candidates(sc.surface, boxes, bytes);
+        break;
       case Cgal:
         pairs = threads == 1 ? cgal_candidates<CGAL::Sequential_tag>(sc.surface, boxes, bytes)
                              : cgal_candidates<CGAL::Parallel_tag>(sc.surface, boxes, bytes);
@@ -321,14 +340,14 @@ void bench_search(benchmark::State& state, int kind, int size, Method method, in
   }
   if (method == Ours || method == Brute) {
     const SweptBoxes boxes = swept_boxes(sc.surface, sc.x_old, sc.x_new);
-    bytes = bytes_of(boxes) +
-            (method == Ours ? memory_bytes(build_sparse_bucket(boxes.triangles)) +
-                                  memory_bytes(build_sparse_bucket(boxes.edges))
-                            : 0);
+    bytes = bytes_of(boxes) + (method == Ours ? memory_bytes(build_sparse_bucket(boxes.triangles)) +
+                                                    memory_bytes(build_sparse_bucket(boxes.edges))
+                                              : 0);
   }
   state.counters["triangles"] = static_cast<double>(sc.surface.num_triangles());
   state.counters["candidates"] = static_cast<double>(candidates);
-  state.counters["cand_per_s"] = benchmark::Counter(static_cast<double>(candidates), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["cand_per_s"] = benchmark::Counter(static_cast<double>(candidates),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
   state.counters["bytes"] = static_cast<double>(bytes);
   state.counters["threads"] = threads;
 }
@@ -346,11 +365,13 @@ void register_all() {
         for (int threads : {1, 2}) {
           const bool large = kind != 0 && size >= 100000;
           if (method == Brute && (threads == 2 || (kind != 0 && size > 10000))) continue;
-          if (method == Cgal && threads == 2 && size >= 1000000) continue;  // its Parallel_tag does not help here
-          const std::string name = std::string("contact_search/") + kKinds[kind] + "/" + std::to_string(size) +
-                                   "/" + kMethods[method] + "/threads:" + std::to_string(threads);
-          auto* b = benchmark::RegisterBenchmark(name.c_str(), bench_search, kind, size, static_cast<Method>(method),
-                                                 threads)
+          if (method == Cgal && threads == 2 && size >= 1000000)
+            continue;  // its Parallel_tag does not help here
+          const std::string name = std::string("contact_search/") + kKinds[kind] + "/" +
+                                   std::to_string(size) + "/" + kMethods[method] +
+                                   "/threads:" + std::to_string(threads);
+          auto* b = benchmark::RegisterBenchmark(name.c_str(), bench_search, kind, size,
+                                                 static_cast<Method>(method), threads)
                         ->Unit(benchmark::kMillisecond)
                         ->UseRealTime()
                         ->Repetitions(size >= 1000000 ? 1 : 3)

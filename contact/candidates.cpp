@@ -1,11 +1,11 @@
 #include "contact/candidates.hpp"
 
-#include <algorithm>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
+#include <algorithm>
 
 #include "kernels/error.hpp"
 
@@ -13,7 +13,8 @@ namespace shatter {
 namespace {
 
 template <size_t K>
-Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old,
+              std::span<const Vec3> x_new) {
   Box b{x_old[nodes[0]], x_old[nodes[0]]};
   for (const Index n : nodes) {
     b.lo = b.lo.cwiseMin(x_old[n]).cwiseMin(x_new[n]);
@@ -29,14 +30,15 @@ template <size_t K, class Nodes>
 void fill_boxes(std::vector<Box>& out, const Nodes& nodes, std::span<const Vec3> x_old,
                 std::span<const Vec3> x_new) {
   out.resize(nodes.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size()), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      if constexpr (K == 1)
-        out[k] = swept_box(std::array<Index, 1>{nodes[k]}, x_old, x_new);
-      else
-        out[k] = swept_box(nodes[k], x_old, x_new);
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size()),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t k = r.begin(); k != r.end(); ++k) {
+                        if constexpr (K == 1)
+                          out[k] = swept_box(std::array<Index, 1>{nodes[k]}, x_old, x_new);
+                        else
+                          out[k] = swept_box(nodes[k], x_old, x_new);
+                      }
+                    });
 }
 
 /// Pairs collected in per-thread buffers. Which buffer holds a pair depends
@@ -54,12 +56,14 @@ ContactPairs concatenate(PairBuffers& buffers) {
 
 }  // namespace
 
-SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old,
+                       std::span<const Vec3> x_new) {
   SHATTER_REQUIRE(x_old.size() == x_new.size(),
                   "swept_boxes: x_old has " << x_old.size() << " nodes, x_new " << x_new.size());
-  SHATTER_REQUIRE(surface.vertices.empty() || static_cast<size_t>(surface.vertices.back()) < x_old.size(),
-                  "swept_boxes: surface node " << surface.vertices.back() << " beyond the " << x_old.size()
-                                               << " positions");
+  SHATTER_REQUIRE(
+      surface.vertices.empty() || static_cast<size_t>(surface.vertices.back()) < x_old.size(),
+      "swept_boxes: surface node " << surface.vertices.back() << " beyond the " << x_old.size()
+                                   << " positions");
   SweptBoxes boxes;
   fill_boxes<3>(boxes.triangles, surface.triangles, x_old, x_new);
   fill_boxes<2>(boxes.edges, surface.edges, x_old, x_new);
@@ -102,24 +106,30 @@ ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& bo
   // higher levels (none when all edges share one level).
   const size_t nv = boxes.vertices.size(), nc = edges.cell_key.size();
   const size_t ne_above = edges.num_levels() > 1 ? boxes.edges.size() : 0;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + nc + ne_above, 64), [&](const tbb::blocked_range<size_t>& r) {
-    ContactPairs& out = buffers.local();
-    auto add_edge_pair = [&](Index a, Index b) {
-      if (auto p = edge_edge_pair(surface, std::min(a, b), std::max(a, b))) out.push_back(*p);
-    };
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      if (k < nv) {
-        const auto v = static_cast<Index>(k);
-        query_sparse_bucket(triangles, boxes.triangles, boxes.vertices[k], [&](Index t) {
-          if (auto p = vertex_face_pair(surface, v, t)) out.push_back(*p);
-        });
-      } else if (k < nv + nc) {
-        self_join_sparse_bucket_cell(edges, boxes.edges, static_cast<Index>(k - nv), add_edge_pair);
-      } else {
-        self_join_sparse_bucket_above(edges, boxes.edges, static_cast<Index>(k - nv - nc), add_edge_pair);
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + nc + ne_above, 64),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      ContactPairs& out = buffers.local();
+                      auto add_edge_pair = [&](Index a, Index b) {
+                        if (auto p = edge_edge_pair(surface, std::min(a, b), std::max(a, b)))
+                          out.push_back(*p);
+                      };
+                      for (size_t k = r.begin(); k != r.end(); ++k) {
+                        if (k < nv) {
+                          const auto v = static_cast<Index>(k);
+                          query_sparse_bucket(triangles, boxes.triangles, boxes.vertices[k],
+                                              [&](Index t) {
+                                                if (auto p = vertex_face_pair(surface, v, t))
+                                                  out.push_back(*p);
+                                              });
+                        } else if (k < nv + nc) {
+                          self_join_sparse_bucket_cell(edges, boxes.edges,
+                                                       static_cast<Index>(k - nv), add_edge_pair);
+                        } else {
+                          self_join_sparse_bucket_above(
+                              edges, boxes.edges, static_cast<Index>(k - nv - nc), add_edge_pair);
+                        }
+                      }
+                    });
   ContactPairs pairs = concatenate(buffers);
   canonicalize(pairs);
   return pairs;
@@ -127,7 +137,8 @@ ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& bo
 
 ContactPairs find_candidates_brute_force(const ContactSurface& surface, const SweptBoxes& boxes) {
   ContactPairs pairs;
-  const auto nv = static_cast<Index>(boxes.vertices.size()), nt = static_cast<Index>(boxes.triangles.size());
+  const auto nv = static_cast<Index>(boxes.vertices.size()),
+             nt = static_cast<Index>(boxes.triangles.size());
   const auto ne = static_cast<Index>(boxes.edges.size());
   for (Index v = 0; v < nv; ++v)
     for (Index t = 0; t < nt; ++t)

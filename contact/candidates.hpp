@@ -31,7 +31,8 @@ struct SweptBoxes {
   std::vector<Box> vertices;
 };
 
-SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new);
+SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old,
+                       std::span<const Vec3> x_new);
 
 /// The vertex-face pair of surface vertex v and triangle t, nodes
 /// {vertex, tri0, tri1, tri2}; none when the vertex is a node of the triangle.

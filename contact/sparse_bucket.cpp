@@ -14,14 +14,17 @@ namespace {
 /// Nearest float not above (below) x, so float bounds contain the double box.
 float round_down(double x) {
   const auto f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                    : f;
 }
 float round_up(double x) {
   const auto f = static_cast<float>(x);
   return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
-double largest_side(const Box& b) { return (b.hi - b.lo).maxCoeff(); }
+double largest_side(const Box& b) {
+  return (b.hi - b.lo).maxCoeff();
+}
 
 Box bounding_box(std::span<const Box> boxes) {
   const double inf = std::numeric_limits<double>::infinity();
@@ -35,7 +38,9 @@ Box bounding_box(std::span<const Box> boxes) {
         }
         return acc;
       },
-      [](const Box& a, const Box& b) { return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; });
+      [](const Box& a, const Box& b) {
+        return Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)};
+      });
 }
 
 /// h_0 = 2 x median largest side, the median taken over an evenly strided
@@ -94,7 +99,8 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   }
 
   const int u = b.axis[0], v = b.axis[1];
-  auto cell_range = [&](size_t k, std::uint64_t& i0, std::uint64_t& i1, std::uint64_t& j0, std::uint64_t& j1) {
+  auto cell_range = [&](size_t k, std::uint64_t& i0, std::uint64_t& i1, std::uint64_t& j0,
+                        std::uint64_t& j1) {
     const int l = level[k];
     i0 = b.cell(0, l, boxes[k].lo[u]);
     i1 = b.cell(0, l, boxes[k].hi[u]);
@@ -130,7 +136,8 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
       size_t p = first[k];
       for (std::uint64_t i = i0; i <= i1; ++i)
         for (std::uint64_t j = j0; j <= j1; ++j)
-          entries[p++] = {SparseBucket::key(level[k], i, j), boxes[k].lo[wa], static_cast<Index>(k)};
+          entries[p++] = {SparseBucket::key(level[k], i, j), boxes[k].lo[wa],
+                          static_cast<Index>(k)};
     }
   });
   // A total order, so the sorted array is the same for any thread count.
@@ -146,8 +153,8 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const Box& x = boxes[entries[k].box];
       b.entry_lo[k] = round_down(entries[k].lo);
-      b.entry_bounds[k] = {round_up(x.hi[wa]), round_down(x.lo[u]), round_up(x.hi[u]), round_down(x.lo[v]),
-                           round_up(x.hi[v])};
+      b.entry_bounds[k] = {round_up(x.hi[wa]), round_down(x.lo[u]), round_up(x.hi[u]),
+                           round_down(x.lo[v]), round_up(x.hi[v])};
       b.entry_box[k] = entries[k].box;
     }
   });
@@ -174,10 +181,12 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
 }
 
 std::size_t memory_bytes(const SparseBucket& b) {
-  return sizeof(SparseBucket) + (b.cell_size.capacity() + b.cell_inverse.capacity()) * sizeof(double) +
+  return sizeof(SparseBucket) +
+         (b.cell_size.capacity() + b.cell_inverse.capacity()) * sizeof(double) +
          b.level_cells.capacity() * sizeof(Index) + b.cell_key.capacity() * sizeof(std::uint64_t) +
          b.cell_entries.capacity() * sizeof(Index) + b.cell_max_extent.capacity() * sizeof(double) +
-         b.entry_lo.capacity() * sizeof(float) + b.entry_bounds.capacity() * sizeof(std::array<float, 5>) +
+         b.entry_lo.capacity() * sizeof(float) +
+         b.entry_bounds.capacity() * sizeof(std::array<float, 5>) +
          b.entry_box.capacity() * sizeof(Index);
 }
 

@@ -103,15 +103,16 @@ inline int sparse_bucket_level(double h0, const Box& x) {
 /// Call report(id) once for every box on level l that overlaps q (see
 /// query_sparse_bucket).
 template <class Report>
-void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes, const Box& q, int l,
-                               Report&& report) {
+void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes, const Box& q,
+                               int l, Report&& report) {
   const int u = b.axis[0], v = b.axis[1], w = b.axis[2];
   // relative size of a float ulp, twice, plus the smallest normal float
   constexpr double kRound = 0x1p-22;
   constexpr double kTiny = std::numeric_limits<float>::min();
   const std::uint64_t i0 = b.cell(0, l, q.lo[u]), i1 = b.cell(0, l, q.hi[u]);
   const std::uint64_t j0 = b.cell(1, l, q.lo[v]), j1 = b.cell(1, l, q.hi[v]);
-  const auto first = b.cell_key.begin() + b.level_cells[l], last = b.cell_key.begin() + b.level_cells[l + 1];
+  const auto first = b.cell_key.begin() + b.level_cells[l],
+             last = b.cell_key.begin() + b.level_cells[l + 1];
   // Walk only the non-empty cells of rows i0..i1, jumping over gaps by bisection.
   auto it = std::lower_bound(first, last, SparseBucket::key(l, i0, j0));
   while (it != last) {
@@ -134,14 +135,17 @@ void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes
     const auto lo_first = b.entry_lo.begin() + b.cell_entries[c];
     const auto lo_last = b.entry_lo.begin() + b.cell_entries[c + 1];
     const auto e_end = static_cast<size_t>(b.cell_entries[c + 1]);
-    for (auto e = static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
+    for (auto e =
+             static_cast<size_t>(std::lower_bound(lo_first, lo_last, w_from) - b.entry_lo.begin());
          e != e_end && b.entry_lo[e] <= q.hi[w]; ++e) {
       const auto& f = b.entry_bounds[e];
-      if (f[0] < q.lo[w] || f[1] > q.hi[u] || f[2] < q.lo[u] || f[3] > q.hi[v] || f[4] < q.lo[v]) continue;
+      if (f[0] < q.lo[w] || f[1] > q.hi[u] || f[2] < q.lo[u] || f[3] > q.hi[v] || f[4] < q.lo[v])
+        continue;
       const Index id = b.entry_box[e];
       const Box& x = boxes[id];
       if (!boxes_overlap(q, x)) continue;
-      if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i && b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
+      if (b.cell(0, l, std::max(q.lo[u], x.lo[u])) == i &&
+          b.cell(1, l, std::max(q.lo[v], x.lo[v])) == j)
         report(id);
     }
     ++it;
@@ -152,7 +156,8 @@ void query_sparse_bucket_level(const SparseBucket& b, std::span<const Box> boxes
 /// built on) that overlaps q. Each pair is reported from one cell only: the
 /// cell that holds the lowest corner of the intersection, max(q.lo, box.lo).
 template <class Report>
-void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, const Box& q, Report&& report) {
+void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, const Box& q,
+                         Report&& report) {
   for (int l = 0; l < b.num_levels(); ++l) query_sparse_bucket_level(b, boxes, q, l, report);
 }
 
@@ -161,7 +166,8 @@ void query_sparse_bucket(const SparseBucket& b, std::span<const Box> boxes, cons
 /// sweep along w over the cell's sorted entries: O(entries + pairs tested).
 /// Over all cells c in [0, C) every overlapping same-level pair comes once.
 template <class Report>
-void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> boxes, Index c, Report&& report) {
+void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> boxes, Index c,
+                                  Report&& report) {
   const int u = b.axis[0], v = b.axis[1];
   const std::uint64_t key = b.cell_key[c];
   const int l = static_cast<int>(key >> (2 * SparseBucket::kCellBits));
@@ -176,7 +182,8 @@ void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> bo
       if (fq[1] > fp[2] || fq[2] < fp[1] || fq[3] > fp[4] || fq[4] < fp[3]) continue;
       const Box& y = boxes[b.entry_box[q]];
       if (!boxes_overlap(x, y)) continue;
-      if (b.cell(0, l, std::max(x.lo[u], y.lo[u])) == i && b.cell(1, l, std::max(x.lo[v], y.lo[v])) == j)
+      if (b.cell(0, l, std::max(x.lo[u], y.lo[u])) == i &&
+          b.cell(1, l, std::max(x.lo[v], y.lo[v])) == j)
         report(b.entry_box[p], b.entry_box[q]);
     }
   }
@@ -186,7 +193,8 @@ void self_join_sparse_bucket_cell(const SparseBucket& b, std::span<const Box> bo
 /// box k's that overlaps box k. With part 1 over all cells and part 2 over
 /// all boxes, every overlapping pair of distinct boxes comes exactly once.
 template <class Report>
-void self_join_sparse_bucket_above(const SparseBucket& b, std::span<const Box> boxes, Index k, Report&& report) {
+void self_join_sparse_bucket_above(const SparseBucket& b, std::span<const Box> boxes, Index k,
+                                   Report&& report) {
   if (b.num_levels() < 2) return;
   for (int l = sparse_bucket_level(b.cell_size[0], boxes[k]) + 1; l < b.num_levels(); ++l)
     query_sparse_bucket_level(b, boxes, boxes[k], l, [&](Index id) { report(k, id); });

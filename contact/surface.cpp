@@ -11,7 +11,8 @@ namespace shatter {
 namespace {
 
 /// Outward faces of a positive tetrahedron (Gmsh corner order).
-constexpr std::array<std::array<int, 3>, 4> kOutwardFaces = {{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+constexpr std::array<std::array<int, 3>, 4> kOutwardFaces = {
+    {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
 
 /// Local TET10 node on the edge between corners i and j.
 int tet10_mid_node(int i, int j) {
@@ -34,7 +35,8 @@ std::vector<std::array<int, 3>> face_triangles(int order, int face) {
 
 /// Sorted unique edges {lo, hi} and vertices of a range of triangles.
 void triangle_edges_and_vertices(std::span<const SurfaceTriangle> triangles,
-                                 std::vector<std::array<Index, 2>>& edges, std::vector<Index>& vertices) {
+                                 std::vector<std::array<Index, 2>>& edges,
+                                 std::vector<Index>& vertices) {
   edges.clear();
   vertices.clear();
   edges.reserve(3 * triangles.size());
@@ -63,7 +65,8 @@ void merge_unique(std::vector<T>& into, const std::vector<T>& more) {
 }  // namespace
 
 ContactSurface build_contact_surface(const Mesh& mesh) {
-  SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "build_contact_surface: mesh order " << mesh.order
+  SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "build_contact_surface: mesh order "
+                                                          << mesh.order
                                                           << " (expected 1 = TET4 or 2 = TET10)");
   // Every face as (sorted corner ids, element, local face); a face is on the
   // boundary when its sorted key occurs once.
@@ -78,7 +81,8 @@ ContactSurface build_contact_surface(const Mesh& mesh) {
   for (Index e = 0; e < ne; ++e) {
     const Index* n = mesh.element(e);
     for (int f = 0; f < 4; ++f) {
-      std::array<Index, 3> key = {n[kOutwardFaces[f][0]], n[kOutwardFaces[f][1]], n[kOutwardFaces[f][2]]};
+      std::array<Index, 3> key = {n[kOutwardFaces[f][0]], n[kOutwardFaces[f][1]],
+                                  n[kOutwardFaces[f][2]]};
       std::sort(key.begin(), key.end());
       faces.push_back({key, e, f});
     }
@@ -101,7 +105,8 @@ ContactSurface build_contact_surface(const Mesh& mesh) {
   triangles.reserve(boundary.size() * local_triangles[0].size());
   for (const auto& [e, f] : boundary) {
     const Index* n = mesh.element(e);
-    for (const auto& t : local_triangles[f]) triangles.push_back({{n[t[0]], n[t[1]], n[t[2]]}, mesh.elem_body[e]});
+    for (const auto& t : local_triangles[f])
+      triangles.push_back({{n[t[0]], n[t[1]], n[t[2]]}, mesh.elem_body[e]});
   }
   return make_contact_surface(triangles);
 }

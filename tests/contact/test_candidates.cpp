@@ -49,8 +49,8 @@ void expect_well_formed(const ContactPairs& pairs) {
 }
 
 /// find_candidates == brute force on the same boxes, and the test is not vacuous.
-void expect_equals_brute_force(const ContactSurface& s, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
-                               size_t min_pairs = 1) {
+void expect_equals_brute_force(const ContactSurface& s, std::span<const Vec3> x_old,
+                               std::span<const Vec3> x_new, size_t min_pairs = 1) {
   const ContactPairs fast = find_candidates(s, x_old, x_new);
   const ContactPairs brute = find_candidates_brute_force(s, swept_boxes(s, x_old, x_new));
   EXPECT_GE(brute.size(), min_pairs);
@@ -64,18 +64,22 @@ void expect_equals_brute_force(const ContactSurface& s, std::span<const Vec3> x_
 Soup random_soup(unsigned seed, int n, double largest) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto random_vec = [&](double scale) -> Vec3 { return Vec3(unit(rng), unit(rng), unit(rng)) * scale; };
+  auto random_vec = [&](double scale) -> Vec3 {
+    return Vec3(unit(rng), unit(rng), unit(rng)) * scale;
+  };
   Soup soup;
   for (int k = 0; k < n; ++k) {
     const double size = largest * std::pow(10.0, -2.0 * unit(rng));
     const Vec3 c = random_vec(1.0);
-    soup.add_triangle({c + random_vec(size), c + random_vec(size), c + random_vec(size)}, random_vec(size), k % 3);
+    soup.add_triangle({c + random_vec(size), c + random_vec(size), c + random_vec(size)},
+                      random_vec(size), k % 3);
   }
   // a neighbour across an edge of every other triangle, so edges are shared
   for (int k = 0; k < n; k += 2) {
     const auto [a, b, c] = soup.triangles[k].nodes;
-    const Index d = soup.add_node(soup.x_old[c] + (soup.x_old[a] - soup.x_old[c]) + (soup.x_old[b] - soup.x_old[c]),
-                                  soup.x_new[a] + soup.x_new[b] - soup.x_new[c]);
+    const Index d = soup.add_node(
+        soup.x_old[c] + (soup.x_old[a] - soup.x_old[c]) + (soup.x_old[b] - soup.x_old[c]),
+        soup.x_new[a] + soup.x_new[b] - soup.x_new[c]);
     soup.triangles.push_back({{b, a, d}, soup.triangles[k].body});
   }
   return soup;
@@ -107,14 +111,14 @@ TEST(Candidates, TwoMovingMeshedBodiesEqualBruteForce) {
   std::vector<Vec3> x_new(m.reference);
   for (Index n = 0; n < m.num_nodes(); ++n) {
     const Vec3& X = m.reference[n];
-    x_new[n] = m.node_body[n] == 0 ? Vec3(X + Vec3(0.1, 0.02, 0)) : Vec3(X + 0.05 * Vec3(-X[1], X[0] - 1.05, 0));
+    x_new[n] = m.node_body[n] == 0 ? Vec3(X + Vec3(0.1, 0.02, 0))
+                                   : Vec3(X + 0.05 * Vec3(-X[1], X[0] - 1.05, 0));
   }
   const ContactPairs fast = find_candidates(s, m.reference, x_new);
   expect_equals_brute_force(s, m.reference, x_new, 1000);
   // both self contact and contact between the bodies are found
   bool across = false;
-  for (const auto& p : fast)
-    across = across || m.node_body[p.nodes[0]] != m.node_body[p.nodes[3]];
+  for (const auto& p : fast) across = across || m.node_body[p.nodes[0]] != m.node_body[p.nodes[3]];
   EXPECT_TRUE(across);
 }
 
@@ -132,9 +136,9 @@ void add_plane_grid(Soup& soup, int n, double z0, const Vec3& shift, const Vec3&
 TEST(Candidates, CoplanarAndCoincidentGeometryEqualsBruteForce) {
   Soup soup;
   add_plane_grid(soup, 12, 0.0, Vec3::Zero(), Vec3::Zero());
-  add_plane_grid(soup, 12, 0.0, Vec3::Zero(), Vec3::Zero());           // coincident copy
-  add_plane_grid(soup, 12, 0.0, Vec3(0.5, 0.25, 0), Vec3::Zero());     // coplanar, shifted
-  add_plane_grid(soup, 6, 0.0, Vec3(2, 2, 0), Vec3(0, 0, 0.5));        // lifting off the plane
+  add_plane_grid(soup, 12, 0.0, Vec3::Zero(), Vec3::Zero());        // coincident copy
+  add_plane_grid(soup, 12, 0.0, Vec3(0.5, 0.25, 0), Vec3::Zero());  // coplanar, shifted
+  add_plane_grid(soup, 6, 0.0, Vec3(2, 2, 0), Vec3(0, 0, 0.5));     // lifting off the plane
   expect_equals_brute_force(make_contact_surface(soup.triangles), soup.x_old, soup.x_new, 1000);
 }
 
@@ -147,9 +151,15 @@ TEST(Candidates, DegenerateTrianglesEqualBruteForce) {
     const Vec3 d = 0.05 * Vec3(unit(rng), unit(rng), unit(rng));
     const Vec3 motion = (k % 2) ? Vec3::Zero() : Vec3(0.01 * unit(rng), 0, 0);
     switch (k % 3) {
-      case 0: soup.add_triangle({a, a, a}, motion); break;               // a point
-      case 1: soup.add_triangle({a, a + d, a + 2.0 * d}, motion); break;  // collinear
-      default: soup.add_triangle({a, a + d, a + d}, motion); break;       // two nodes coincide
+      case 0:
+        soup.add_triangle({a, a, a}, motion);
+        break;  // a point
+      case 1:
+        soup.add_triangle({a, a + d, a + 2.0 * d}, motion);
+        break;  // collinear
+      default:
+        soup.add_triangle({a, a + d, a + d}, motion);
+        break;  // two nodes coincide
     }
   }
   expect_equals_brute_force(make_contact_surface(soup.triangles), soup.x_old, soup.x_new, 10);
@@ -165,7 +175,8 @@ TEST(Candidates, VeryElongatedBoxesEqualBruteForce) {
     Vec3 along = Vec3::Zero();
     along[axis] = 1.0;
     const Vec3 p(unit(rng), unit(rng), unit(rng));
-    const Vec3 a = p - 0.5 * along, b = p + 0.5 * along, c = p + 1e-3 * Vec3(unit(rng), unit(rng), unit(rng));
+    const Vec3 a = p - 0.5 * along, b = p + 0.5 * along,
+               c = p + 1e-3 * Vec3(unit(rng), unit(rng), unit(rng));
     soup.add_triangle({a, b, c}, (k % 4 == 0) ? Vec3(0, 0, 0.001) : Vec3::Zero());
   }
   expect_equals_brute_force(make_contact_surface(soup.triangles), soup.x_old, soup.x_new, 100);
@@ -243,7 +254,8 @@ TEST(SparseBucket, BoxesOnBucketBoundariesAreReportedExactlyOnce) {
     std::vector<Index> found;
     query_sparse_bucket(bucket, boxes, q, [&](Index id) { found.push_back(id); });
     std::sort(found.begin(), found.end());
-    EXPECT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end()) << "duplicate report";
+    EXPECT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end())
+        << "duplicate report";
     EXPECT_EQ(found, overlapping(boxes, q));
   }
 }

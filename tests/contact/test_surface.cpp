@@ -60,7 +60,8 @@ double piecewise_flat_volume(const Mesh& m) {
       continue;
     }
     for (const auto& c : kCorner) v += tet_volume(x(c[0]), x(c[1]), x(c[2]), x(c[3]));
-    for (int k = 0; k < 4; ++k) v += std::abs(tet_volume(x(4), x(8), x(kRing[k]), x(kRing[(k + 1) % 4])));
+    for (int k = 0; k < 4; ++k)
+      v += std::abs(tet_volume(x(4), x(8), x(kRing[k]), x(kRing[(k + 1) % 4])));
   }
   return v;
 }
@@ -80,7 +81,8 @@ TEST_P(BallSurface, IsClosedOrientedGenusZeroWithOutwardNormals) {
     for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
   for (const auto& [e, count] : directed) {
     EXPECT_EQ(count, 1) << "directed edge " << e[0] << "-" << e[1];
-    EXPECT_EQ(directed.count({e[1], e[0]}), 1u) << "edge " << e[0] << "-" << e[1] << " has one triangle";
+    EXPECT_EQ(directed.count({e[1], e[0]}), 1u)
+        << "edge " << e[0] << "-" << e[1] << " has one triangle";
   }
   EXPECT_EQ(directed.size(), 2 * s.edges.size());
   EXPECT_EQ(static_cast<Index>(s.vertices.size()) - s.num_edges() + s.num_triangles(), 2);
@@ -163,7 +165,8 @@ TEST(ContactSurface, ExtendingAMeshSurfaceEqualsBuildingTheUnion) {
   const ContactSurface sb = build_contact_surface(b);
   std::vector<SurfaceTriangle> extra;
   for (Index t = 0; t < sb.num_triangles(); ++t)
-    extra.push_back({{sb.triangles[t][0] + shift, sb.triangles[t][1] + shift, sb.triangles[t][2] + shift}, 1});
+    extra.push_back(
+        {{sb.triangles[t][0] + shift, sb.triangles[t][1] + shift, sb.triangles[t][2] + shift}, 1});
   ContactSurface extended = build_contact_surface(a);
   add_triangles(extended, extra);
   append_mesh(a, b);
