@@ -38,7 +38,7 @@ inline bool boxes_overlap(const Box& a, const Box& b) {
 /// passes again to each query). Ids are positions in that span.
 ///
 /// Layouts (L levels, C non-empty cells over all levels, N entries = box-cell
-/// incidences, N <= 4 x boxes):
+/// incidences, N <= 4 x boxes up to rounding in floor):
 ///   axis = {u, v, w}                w = the axis along which all boxes spread most
 ///   origin[2]                       lowest lo along u and v
 ///   cell_size[L]                    h_l = h_0 4^l; h_0 = 2 x the median largest box side
