@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "kernels/error.hpp"
 
@@ -35,16 +36,32 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   SHATTER_REQUIRE(stress.size() >= static_cast<size_t>(mesh.num_elements()) * stress_size,
                   "critical_facets: " << stress.size() << " stress values for "
                                       << mesh.num_elements() << " elements");
-  const Index nf = topo.num_facets();
+  const Index nf = topo.num_facets(), ne = mesh.num_elements();
+  // A cheap exact filter: the effective traction on any plane is at most
+  // |t| max(1, 1/beta) <= |sigma|_F max(1, 1/beta), and the facet's stress is
+  // the mean of its two elements', so a facet with
+  // (|sigma_0|_F + |sigma_1|_F) / 2 x max(1, 1/beta) < sigma_c cannot break.
+  std::vector<double> frobenius(ne);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, ne, 2048), [&](const tbb::blocked_range<Index>& r) {
+    for (Index e = r.begin(); e != r.end(); ++e) frobenius[e] = element_cauchy_stress(stress, stress_size, e).norm();
+  });
+  double weakest = HUGE_VAL, widest = 1.0;  // smallest sigma_c, largest max(1, 1/beta)
+  for (const auto& law : laws)
+    if (law) {
+      weakest = std::min(weakest, law->sigma_c);
+      widest = std::max(widest, 1.0 / law->beta);
+    }
+  if (*std::max_element(frobenius.begin(), frobenius.end()) * widest < weakest) return {};
   // One flag per facet, then a serial gather: the output is independent of
   // how the range is split among threads.
   std::vector<char> breaks(nf, 0);
   tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 512), [&](const tbb::blocked_range<Index>& r) {
     for (Index f = r.begin(); f != r.end(); ++f) {
       if (topo.facet_state[f] != FacetState::intact) continue;
-      const CohesiveLaw* law = facet_law(mesh, topo, laws, f);
+      const CohesiveLaw* law = facet_law(mesh, topo, laws, f);  // none on the boundary
       if (!law) continue;
       const auto [e0, e1] = topo.facet_elem[f];
+      if (0.5 * (frobenius[e0] + frobenius[e1]) * std::max(1.0, 1.0 / law->beta) < law->sigma_c) continue;
       const std::array<Index, 6> fn = face_nodes(mesh, e0, topo.facet_face[f][0]);
       const Vec3 area_vector = (x[fn[1]] - x[fn[0]]).cross(x[fn[2]] - x[fn[0]]);
       const Vec3 n = area_vector.normalized();

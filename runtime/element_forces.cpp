@@ -50,39 +50,73 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     for (size_t i = r.begin(); i < r.end(); ++i) f_int[i].setZero();
   });
 
+  // TET4: four consecutive elements of one material go through the lane
+  // kernel together (vectorised across elements); the rest one at a time
+  // through the same code with one lane, so the forces are the same bits.
+  auto tet4_group = [&]<int N>(Index e0, const NeoHookean& m, double& energy, double& dt2, double& minJ,
+                               Index& worst) {
+    Tet4Lanes<N> L;
+    for (int l = 0; l < N; ++l) {
+      const Index* c = conn + 4 * static_cast<size_t>(e0 + l);
+      for (int a = 0; a < 4; ++a)
+        for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = x[c[a]][i];
+      const double* D = model_.tet4_Dm_inv[e0 + l].data();
+      for (int q = 0; q < 9; ++q) L.Dm_inv[q][l] = D[q];
+      L.V0[l] = model_.element_volume[e0 + l];
+    }
+    tet4_neo_hookean_lanes(L, m);
+    double lane_dt2[N];
+    tet4_stable_dt_squared_lanes(L, m, lane_dt2);
+    for (int l = 0; l < N; ++l) {
+      const Index* c = conn + 4 * static_cast<size_t>(e0 + l);
+      for (int a = 0; a < 4; ++a) f_int[c[a]] += Vec3(L.f[3 * a][l], L.f[3 * a + 1][l], L.f[3 * a + 2][l]);
+      energy += L.energy[l];
+      dt2 = std::min(dt2, lane_dt2[l]);
+      if (worse(L.J[l], minJ)) {
+        minJ = L.J[l];
+        worst = e0 + l;
+      }
+    }
+  };
+
   auto run_block = [&](Index b) {
-    double energy = 0, dt = HUGE_VAL, minJ = HUGE_VAL;
+    double energy = 0, dt = HUGE_VAL, dt2 = HUGE_VAL, minJ = HUGE_VAL;
     Index worst = -1;
     const Index end = std::min(ne, (b + 1) * kBlock);
-    for (Index e = b * kBlock; e < end; ++e) {
-      const NeoHookean& m = mats[mat[e]];
-      double J, h;
-      if (mesh.order == 1) {
-        const Index* c = conn + 4 * static_cast<size_t>(e);
-        const Vec3 &x0 = x[c[0]], &x1 = x[c[1]], &x2 = x[c[2]], &x3 = x[c[3]];
-        const Tet4Force out = tet4_internal_force(x0, x1, x2, x3, model_.tet4_Dm_inv[e], model_.element_volume[e], m);
-        for (int a = 0; a < 4; ++a) f_int[c[a]] += out.f.col(a);
-        energy += out.energy;
-        J = out.J;
-        h = tet4_stable_length(x0, x1, x2, x3);
-      } else {
+    if (mesh.order == 1) {
+      Index e = b * kBlock;
+      while (e < end) {
+        const int m = mat[e];
+        if (e + 4 <= end && mat[e + 1] == m && mat[e + 2] == m && mat[e + 3] == m) {
+          tet4_group.template operator()<4>(e, mats[m], energy, dt2, minJ, worst);
+          e += 4;
+        } else {
+          tet4_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
+          e += 1;
+        }
+      }
+      dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt
+    } else {
+      for (Index e = b * kBlock; e < end; ++e) {
+        const NeoHookean& m = mats[mat[e]];
         const Index* c = conn + 10 * static_cast<size_t>(e);
         Tet10Nodes xe;
         for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
         const Tet10Force out = tet10_internal_force(xe, model_.tet10_ref[e], m);
         for (int a = 0; a < 10; ++a) f_int[c[a]] += out.f.col(a);
         energy += out.energy;
-        J = out.J;
-        h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
-      }
-      if (!stress6.empty()) element_cauchy_stress6(model_, x, e, stress6.data() + 6 * static_cast<size_t>(e));
-      // J <= 0 (or NaN) makes the wave speed NaN; the caller diagnoses it.
-      dt = std::min(dt, h / m.wave_speed(J > 0 ? J : 1.0));
-      if (worse(J, minJ)) {
-        minJ = J;
-        worst = e;
+        const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
+        // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
+        dt = std::min(dt, h / m.wave_speed(out.J > 0 ? out.J : 1.0));
+        if (worse(out.J, minJ)) {
+          minJ = out.J;
+          worst = e;
+        }
       }
     }
+    if (!stress6.empty())
+      for (Index e = b * kBlock; e < end; ++e)
+        element_cauchy_stress6(model_, x, e, stress6.data() + 6 * static_cast<size_t>(e));
     block_energy_[b] = energy;
     block_dt_[b] = dt;
     block_min_J_[b] = minJ;

@@ -5,6 +5,7 @@
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
+#include "mesh/reorder.hpp"
 
 namespace shatter {
 
@@ -28,6 +29,10 @@ Model build_model(const Scene& scene) {
     append_mesh(m.mesh, part);
   }
 
+  // Elements along a space-filling curve, nodes by first use: the colored
+  // element loop needs consecutive elements to share nodes (3x faster than
+  // Gmsh's order, and 15 colors instead of 280; docs/performance.md).
+  reorder_for_locality(m.mesh, GlobalIdPolicy::keep);
   const Mesh& mesh = m.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();
