@@ -2,9 +2,14 @@
 //   shatter run SCENE.yaml [--out DIR] [--threads T] [--set key.path=value ...]
 //             [--deterministic] [--restart CHECKPOINT.h5] [--quiet]
 //   shatter check SCENE.yaml [--set ...]
+//   shatter plot OUTDIR        (PNGs of a run's history into OUTDIR/plots/)
 // Exit status: 0 success, 2 bad input, 1 failure during the run.
 #include <mpi.h>
 #include <tbb/global_control.h>
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -49,6 +54,28 @@ void print_check(const Model& model, const Simulation& sim) {
   std::printf("memory: about %.1f MB\n", (model_bytes(model) + state) / 1e6);
 }
 
+/// Run scripts/plot.py of the source tree (SHATTER_SOURCE_DIR) with the Python
+/// that has matplotlib (SHATTER_PYTHON) on a run's output folder; returns the
+/// script's exit status (2: no such folder or no history.csv).
+int plot_outputs(const std::string& out_dir) {
+  const std::string script = std::string(SHATTER_SOURCE_DIR) + "/scripts/plot.py";
+  if (!std::filesystem::is_regular_file(script)) {
+    std::fprintf(stderr, "error: %s: the plot script is missing\n", script.c_str());
+    return 1;
+  }
+  std::string python = SHATTER_PYTHON;
+  std::vector<char*> args{python.data(), const_cast<char*>(script.c_str()), const_cast<char*>(out_dir.c_str()),
+                          nullptr};
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, python.c_str(), nullptr, nullptr, args.data(), environ) != 0) {
+    std::fprintf(stderr, "error: cannot start %s\n", python.c_str());
+    return 1;
+  }
+  int wstatus = 0;
+  if (waitpid(pid, &wstatus, 0) != pid || !WIFEXITED(wstatus)) return 1;
+  return WEXITSTATUS(wstatus);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,6 +103,8 @@ int main(int argc, char** argv) {
   auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
   check->add_option("scene", scene_path, "scene file (YAML)")->required();
   check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+  auto* plot = app.add_subcommand("plot", "plot a run's history.csv into OUTDIR/plots/ (PNG)");
+  plot->add_option("outdir", out_dir, "output folder of a run")->required();
 
   int status = 0;
   try {
@@ -85,6 +114,11 @@ int main(int argc, char** argv) {
       const int rc = app.exit(e);
       MPI_Finalize();
       return rc == 0 ? 0 : 2;
+    }
+    if (*plot) {
+      status = rank == 0 ? plot_outputs(out_dir) : 0;
+      MPI_Finalize();
+      return status;
     }
     if (!restart.empty()) throw InputError("--restart " + restart + ": checkpoint/restart is not implemented yet");
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
