@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "mpi_environment.hpp"
 #include "kernels/error.hpp"
 #include "runtime/field_output.hpp"
 
@@ -22,18 +23,6 @@ namespace shatter {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// MPI for the whole test program (gtest_main has no MPI_Init).
-class MpiEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override {
-    int provided = 0;
-    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-  }
-  void TearDown() override { MPI_Finalize(); }
-};
-[[maybe_unused]] ::testing::Environment* const mpi_environment =
-    ::testing::AddGlobalTestEnvironment(new MpiEnvironment);
 
 int comm_rank(MPI_Comm comm) {
   int r = 0;

@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mpi_environment.hpp"
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 #include "mesh/partition.hpp"
@@ -26,18 +27,6 @@
 
 namespace shatter {
 namespace {
-
-/// MPI for the whole test program (gtest_main has no MPI_Init).
-class MpiEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override {
-    int provided = 0;
-    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-  }
-  void TearDown() override { MPI_Finalize(); }
-};
-[[maybe_unused]] ::testing::Environment* const mpi_environment =
-    ::testing::AddGlobalTestEnvironment(new MpiEnvironment);
 
 /// The global model, built on every rank (Gmsh meshes deterministically), its
 /// partition into the ranks of MPI_COMM_WORLD, and this rank's LocalMesh.
