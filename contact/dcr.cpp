@@ -74,7 +74,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
       w[k] = inv_mass[n];
     }
     const auto kind = pair.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
-    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law, options.dt);
+    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law);
     if (!r.active) return;
     active_now[i] = 1;
     ever_active[i] = 1;

@@ -21,9 +21,6 @@ struct DcrOptions {
   double friction = 0.0;     ///< Coulomb mu >= 0
   double gap = 1e-6;         ///< separation after projection, fraction of the pair's longest edge
   int max_sweeps = 100;      ///< cap on Gauss-Seidel sweeps; reaching it sets DcrResult::capped
-  double dt = 0.0;           ///< the step's length, s: a collision at t* is followed by (1 - t*) dt
-                             ///< of motion with the new velocities (dcr_resolve_pair); 0 = the
-                             ///< collision at the end of the step (projection, then impulse)
 };
 
 /// Summary of one call of resolve_contacts.

@@ -27,10 +27,6 @@
 //   3. momentum decomposition (dcr_impulse), [CW] sec. 3-4: normal part
 //      v_n = grad g . v / (grad g . W grad g), v' = v - (1 + e) v_n W grad g,
 //      then Coulomb friction as a second decomposition along a slide direction.
-// dcr_resolve_pair (with the step length dt > 0) places the collision at t* instead of
-// at the end of the step: the impulse is taken at the contact configuration and the
-// rest of the step, (1 - t*) dt, is travelled with the post-impact velocities; the
-// projection (2) only removes what is left (see dcr_resolve_pair).
 // Pure functions: no allocation, no threads, no I/O.
 #include <algorithm>
 #include <array>
@@ -373,50 +369,23 @@ inline DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPo
 /// Outcome of dcr_resolve_pair.
 struct DcrPairResponse {
   bool active = false;  ///< the pair penetrated and was resolved
-  bool separated = false;  ///< the pair ends with g > 0
+  bool separated = false;  ///< the projection reached g > 0
   DcrImpulse impulse;
 };
 
-/// One DCR resolution of a pair over a step of length dt (s): detect (dcr_detect on
-/// X_old -> X_new); if it penetrates at t*, with tau = (1 - t*) dt > 0:
-///   X_c = X_new - tau V               the contact configuration, reached back along the
-///                                     current velocities (= X_old + t* (X_new - X_old)
-///                                     for a pair that moved freely);
-///   V  <- V + dV                      dcr_impulse at X_c;
-///   X_new <- X_new + tau dV           the rest of the step with the new velocities.
-/// With m_i dV_i a sum of gradients of translation- and rotation-invariant functions at
-/// X_c, this keeps sum m_i V_i and sum x_i x m_i V_i exactly: the cross terms of
-/// X_new = X_c + tau V and V' = V + dV cancel. Placing the collision at t* rather than at
-/// the end of the step also keeps the energy: leaving the pair on the contact surface
-/// does work against the contact force, a loss of about t* dt v_n f_n per impact.
-/// A penetration that remains (e = 0, curvature, a pair already separating after a
-/// neighbour's impact) is removed by dcr_project along the gradient at t*, as in [CW].
-/// With tau = 0 (dt = 0: the collision approximated at the end of the step, [CW]) the
-/// pair is projected first and the impulse taken at the projected positions.
-/// X_new and V are updated in place.
+/// One DCR resolution of a pair over a step: detect (dcr_detect on X_old -> X_new); if it
+/// penetrates, project X_new (dcr_project, direction from the configuration at t*) and
+/// update the velocities V at the projected positions (dcr_impulse). X_new and V are
+/// updated in place.
 inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new,
-                                        PairPoints& V, const PairWeights& inv_mass, const DcrLaw& law,
-                                        double dt = 0.0) {
+                                        PairPoints& V, const PairWeights& inv_mass, const DcrLaw& law) {
   DcrPairResponse out;
   const DcrPenetration pen = dcr_detect(kind, X_old, X_new);
   if (!pen.penetrating) return out;
   out.active = true;
-  const double s = pen.orientation;
-  const PairPoints X_at_t = X_old + pen.time * (X_new - X_old);
-  const double tau = (1.0 - pen.time) * dt;
-  if (!(tau > 0.0)) {
-    out.separated = dcr_project(kind, s, X_at_t, X_new, inv_mass, law.gap);
-    out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
-    return out;
-  }
-  const PairPoints X_contact = X_new - tau * V;
-  const PairPoints V_before = V;
-  out.impulse = dcr_impulse(kind, s, X_contact, V, inv_mass, law);
-  X_new += tau * (V - V_before);
-  // Projected only when the impact left the pair penetrating: a pair that ends just in
-  // front of the face moves off at its new velocity, and every projection changes
-  // sum x x m v by mu sum_i grad_i g x v_i (the sliding velocity across the normal).
-  out.separated = s * pair_volume(X_new) > 0.0 || dcr_project(kind, s, X_at_t, X_new, inv_mass, law.gap);
+  const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
+  out.separated = dcr_project(kind, pen.orientation, X_contact, X_new, inv_mass, law.gap);
+  out.impulse = dcr_impulse(kind, pen.orientation, X_new, V, inv_mass, law);
   return out;
 }
 

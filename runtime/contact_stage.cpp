@@ -13,13 +13,12 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec) : surfac
 }
 
 DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                              std::span<const double> inv_mass, double dt) {
+                              std::span<const double> inv_mass) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const ContactPairs pairs = find_candidates(surface_, x_old, x_new);
   const auto t1 = clock::now();
   contact_pair_nodes(pairs, pair_offsets_, pair_nodes_);
-  options_.dt = dt;
   const Coloring colors = greedy_coloring(pair_offsets_, pair_nodes_, static_cast<Index>(x_new.size()));
   const DcrResult r = resolve_contacts(pairs, x_new, x_old, v, inv_mass, options_, {colors.offsets, colors.items});
   const auto t2 = clock::now();

@@ -15,13 +15,11 @@ class ContactStage {
  public:
   ContactStage(const Model& model, const ContactSpec& spec);
 
-  /// Find the pairs penetrating during the motion x_old -> x_new (one step of
-  /// length dt, s) and resolve them: v (the mid-step velocity) gets the DCR
-  /// impulses, x_new the rest of the step at the new velocities and, where
-  /// that leaves a penetration, the projection back. inv_mass: inverse lumped
-  /// masses, 0 for nodes DCR must not move.
+  /// Find the pairs penetrating during the motion x_old -> x_new and resolve
+  /// them: x_new is projected back, v (the mid-step velocity) gets the DCR
+  /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move.
   DcrResult apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                  std::span<const double> inv_mass, double dt);
+                  std::span<const double> inv_mass);
 
   /// Rebuild the surface after fracture split nodes: crack faces whose sides
   /// no longer share nodes join it, and older triangles get the new node ids.

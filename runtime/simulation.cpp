@@ -141,7 +141,7 @@ void Simulation::step() {
   if (contact_) {
     x_prev_ = x_;
     parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
-    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt);
+    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_);
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
