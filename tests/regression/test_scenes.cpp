@@ -1,0 +1,221 @@
+// Regressions on the small versions of the seeds' examples
+// (scenes/regression/*.yaml): each scene is loaded through load_scene and
+// build_model, run whole with Simulation (no files written) and checked
+// against the figures its header promises:
+//   - linear momentum conserved to 1e-12 of sum |m v| (no gravity, no
+//     boundary conditions);
+//   - total energy within 2 % for frictionless elastic contact (the loss
+//     shrinks as the mesh is refined);
+//   - friction dissipates (contact_dissipated > 0);
+//   - contacts during the impact, and the centre-of-mass velocities after it
+//     turned as the physics says.
+// Known defects (angular momentum through contact, the energy ledger with
+// friction and with many repeated contacts) are checked by a disabled test
+// that records the measured figures.
+// A last test runs `shatter plot` on a small run's output folder.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "expect_close.hpp"
+#include "runtime/model.hpp"
+#include "runtime/scene.hpp"
+#include "runtime/simulation.hpp"
+
+using namespace shatter;
+
+namespace {
+
+std::string scene_path(const std::string& name) {
+  return std::string(SHATTER_SOURCE_DIR) + "/scenes/regression/" + name + ".yaml";
+}
+
+/// Centre-of-mass velocity of every body, m/s.
+std::vector<Vec3> body_velocities(const Model& m, std::span<const Vec3> v) {
+  std::vector<Vec3> mv(m.body_mass.size(), Vec3::Zero());
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i) mv[m.mesh.node_body[i]] += m.mass[i] * v[i];
+  for (size_t b = 0; b < mv.size(); ++b) mv[b] /= m.body_mass[b];
+  return mv;
+}
+
+/// What a whole run of a scene gives: the ledger at the start and end, the
+/// largest energy error and contact count over the run, the body velocities
+/// before and after, and the momentum scales.
+struct SceneRun {
+  Ledger first, last;
+  double max_energy_error = 0;  ///< max |total - total(0)| / total(0)
+  long max_contacts = 0;
+  std::vector<Vec3> v_before, v_after;
+  double p_scale = 0;  ///< sum m |v| at the start, kg m/s
+  double l_scale = 0;  ///< sum m |x| |v| at the start, kg m^2/s
+};
+
+SceneRun run_scene(const std::string& name) {
+  Model model = build_model(load_scene(scene_path(name)));
+  Simulation sim(model, {});
+  SceneRun r;
+  r.first = sim.ledger();
+  r.v_before = body_velocities(model, sim.velocities());
+  for (Index i = 0; i < model.mesh.num_nodes(); ++i) {
+    r.p_scale += model.mass[i] * sim.velocities()[i].norm();
+    r.l_scale += model.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
+  }
+  const double end = model.scene.end_time;
+  while (sim.time() < end - 1e-12 * end) {
+    sim.step();
+    r.max_contacts = std::max(r.max_contacts, sim.ledger().contacts);
+    r.max_energy_error =
+        std::max(r.max_energy_error, std::abs(sim.ledger().total() - r.first.total()) / r.first.total());
+  }
+  r.last = sim.ledger();
+  r.v_after = body_velocities(model, sim.velocities());
+  return r;
+}
+
+void expect_momentum_conserved(const SceneRun& r) {
+  EXPECT_LT((r.last.momentum - r.first.momentum).norm(), 1e-12 * r.p_scale)
+      << "linear momentum changed by " << (r.last.momentum - r.first.momentum).norm() << " of " << r.p_scale;
+}
+
+/// Two bodies meeting off-centre along x (left at +v, right at -v, the right
+/// one higher in y): after the impact each moves back along x and is deflected
+/// in y away from the other.
+void expect_oblique_rebound(const SceneRun& r) {
+  ASSERT_EQ(r.v_after.size(), 2u);
+  EXPECT_LT(r.v_after[0].x(), 0.0);
+  EXPECT_GT(r.v_after[1].x(), 0.0);
+  EXPECT_LT(r.v_after[0].y(), 0.0);
+  EXPECT_GT(r.v_after[1].y(), 0.0);
+}
+
+}  // namespace
+
+// Four spinning cubes thrown at a fifth from four sides: corners and edges
+// hit faces. Measured at ecfc919 (element_size 0.35): energy error max
+// 1.3 %, final -0.8 % (finer meshes lose less: at 0.25, 0.9 % / -0.4 %).
+// Commit 267cf4c (collision at t*, reverted by ecfc919) made it GAIN 15 %:
+// this test is what caught it.
+TEST(Scenes, FiveCubesFrictionless) {
+  const SceneRun r = run_scene("five_cubes");
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_LT(r.max_energy_error, 0.02);
+  EXPECT_EQ(r.last.contact_dissipated, 0.0);
+  // Every thrower (bodies 1-4) has lost at least half of its speed along its
+  // line of flight; the resting hub is set moving.
+  for (int b = 1; b <= 4; ++b) {
+    const Vec3 dir = r.v_before[b].normalized();
+    EXPECT_LT(r.v_after[b].dot(dir), 0.5 * r.v_before[b].norm()) << "body " << b;
+  }
+  EXPECT_GT(r.v_after[0].norm(), 5.0);
+}
+
+TEST(Scenes, FiveCubesFriction) {
+  const SceneRun r = run_scene("five_cubes_friction");
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_GT(r.last.contact_dissipated, 0.01 * r.first.total());
+  EXPECT_LT(r.last.kinetic + r.last.strain, r.first.total());
+}
+
+// Two solid spheres (R = 1) meeting off-centre at 2 x 25 m/s.
+// Measured at ecfc919 (element_size 0.25): energy error max 1.3 %, final -0.9 %.
+TEST(Scenes, SpheresImpactFrictionless) {
+  const SceneRun r = run_scene("spheres_impact");
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_EQ(r.last.contacts, 0);
+  EXPECT_LT(r.max_energy_error, 0.02);
+  expect_oblique_rebound(r);
+}
+
+TEST(Scenes, SpheresImpactFriction) {
+  const SceneRun r = run_scene("spheres_impact_friction");
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_EQ(r.last.contacts, 0);
+  EXPECT_GT(r.last.contact_dissipated, 0.0);
+  expect_oblique_rebound(r);
+}
+
+// Two disks (R = 1, thickness 0.25) meeting rim to rim, off-centre.
+// Measured at ecfc919 (element_size 0.125): energy error max 0.6 %, final -0.3 %.
+TEST(Scenes, TwoDisks) {
+  const SceneRun r = run_scene("two_disks");
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 0);
+  EXPECT_EQ(r.last.contacts, 0);
+  EXPECT_LT(r.max_energy_error, 0.02);
+  expect_oblique_rebound(r);
+}
+
+// 12 spinning cubes flying into a loose 4 x 4 x 4 lattice of slowly spinning
+// cubes. Momenta are kept and the impact travels through the lattice.
+TEST(Scenes, Cubes76) {
+  const SceneRun r = run_scene("cubes76");
+  ASSERT_EQ(r.v_after.size(), 76u);
+  expect_momentum_conserved(r);
+  EXPECT_GT(r.max_contacts, 10);
+  // The lattice cubes (the first 64) that were hit now move along +x.
+  int pushed = 0;
+  for (int b = 0; b < 64; ++b) pushed += r.v_after[b].x() > 1.0;
+  EXPECT_GE(pushed, 4);
+}
+
+// Known defects, measured at commit ecfc919 (run with
+// --gtest_also_run_disabled_tests to see the figures):
+//   - angular momentum through contact, which DCR should keep to round-off
+//     (tests/runtime/test_contact_runs.cpp holds it to 1e-10 of sum m |x| |v|),
+//     changes by 1.9e-5 to 1.8e-4 of that scale in every scene here: the
+//     position projection of pairs left penetrating is not rotation-free;
+//   - the ledger total (with contact_dissipated) with friction drops:
+//     five_cubes_friction -6.5 %, spheres_impact_friction -2.6 % (their
+//     frictionless twins: -0.8 %, -0.9 %);
+//   - cubes76 (2 elements per cube edge, many repeated contacts): -10.9 %,
+//     a little with every contact.
+TEST(Scenes, DISABLED_KnownDefects) {
+  for (const char* name : {"five_cubes", "five_cubes_friction", "spheres_impact", "spheres_impact_friction",
+                           "two_disks", "cubes76"}) {
+    const SceneRun r = run_scene(name);
+    const double dL = (r.last.angular_momentum - r.first.angular_momentum).norm();
+    EXPECT_LT(dL, 1e-10 * r.l_scale) << name << ": angular momentum changed by " << dL / r.l_scale << " of the scale";
+    EXPECT_LT(r.max_energy_error, 0.02) << name << ": final energy error "
+                                        << (r.last.total() - r.first.total()) / r.first.total();
+  }
+}
+
+// `shatter plot` on a run's output folder writes non-empty PNGs, and exits
+// with status 2 on a folder without history.csv.
+TEST(Scenes, PlotWritesPngs) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 has no matplotlib";
+  const auto out = std::filesystem::temp_directory_path() / "shatter_test_plot";
+  std::filesystem::remove_all(out);
+  {
+    Model model = build_model(load_scene(scene_path("spheres_impact")));
+    RunOptions opt;
+    opt.out_dir = out;
+    opt.quiet = true;
+    Simulation sim(model, opt);
+    sim.run();
+  }
+  const std::string shatter = std::string(SHATTER_BINARY_DIR) + "/apps/shatter";
+  const int status = std::system((shatter + " plot " + out.string() + " > /dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  for (const char* png : {"energies.png", "momenta.png", "contacts.png", "fragments.png", "bodies.png"}) {
+    const auto path = out / "plots" / png;
+    ASSERT_TRUE(std::filesystem::is_regular_file(path)) << path;
+    EXPECT_GT(std::filesystem::file_size(path), 1000u) << path;
+  }
+  const auto empty = std::filesystem::temp_directory_path() / "shatter_test_plot_empty";
+  std::filesystem::create_directories(empty);
+  const int missing = std::system((shatter + " plot " + empty.string() + " 2> /dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(missing));
+  EXPECT_EQ(WEXITSTATUS(missing), 2);
+}
