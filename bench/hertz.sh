@@ -13,9 +13,9 @@
 # Run:     bash bench/hertz.sh BUILD_DIR [V] [sizes...]   (default V = 50 m/s,
 #          sizes 1.0e-3 8.0e-4 6.0e-4 m)
 # Output:  bench/results/hertz.csv and a table on stdout.
-# Expect:  the duration within a few percent for the finer meshes (coarse
-#          meshes resolve the contact patch, radius ~0.8 mm at 50 m/s, with one
-#          or two elements); several minutes in all.
+# Expect:  durations 5-12 % short of t_c and peak forces within 20 % at these
+#          sizes (the contact patch, radius ~0.8 mm at 50 m/s, spans one or
+#          two elements; docs/contact.md); about 2 minutes in all.
 set -euo pipefail
 build=${1:?usage: hertz.sh BUILD_DIR [V] [sizes...]}
 shift
