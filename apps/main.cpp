@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "kernels/error.hpp"
+#include "runtime/checkpoint.hpp"
 #include "runtime/model.hpp"
 #include "runtime/report.hpp"
 #include "runtime/scene.hpp"
@@ -120,7 +121,6 @@ int main(int argc, char** argv) {
       MPI_Finalize();
       return status;
     }
-    if (!restart.empty()) throw InputError("--restart " + restart + ": checkpoint/restart is not implemented yet");
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     const Scene scene = load_scene(scene_path, overrides);
     Model model = build_model(scene);
@@ -130,13 +130,17 @@ int main(int argc, char** argv) {
     opt.quiet = quiet;
     opt.deterministic = deterministic;
     if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
+    // A restart continues the outputs beside its checkpoint unless --out says otherwise.
+    if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
     Simulation sim(model, opt);
+    if (!restart.empty()) sim.restore_state(read_checkpoint(restart, model));
     if (*check) {
       print_check(model, sim);
     } else {
-      if (scene.checkpoint && !quiet && rank == 0)
-        std::fprintf(stderr, "warning: %s: checkpoint: checkpoints are not written yet; the key is ignored\n",
-                     scene.file.c_str());
+      if (scene.checkpoint && scene.fracture_enabled() && !quiet && rank == 0)
+        std::fprintf(stderr, "warning: %s: checkpoint: not written for scenes with fracture (a restart of a "
+                     "cracked mesh is not implemented); the key is ignored\n", scene.file.c_str());
+      install_stop_handlers();
       const long steps = sim.run();
       if (!quiet && rank == 0)
         std::fprintf(stderr, "done: %ld steps, energy error %.2e; outputs in %s\n", steps,

@@ -11,10 +11,11 @@
 
 namespace shatter {
 
-CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns)
-    : out_(path), path_(path) {
-  SHATTER_REQUIRE(out_, "cannot create " << path.string());
+CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns, bool append)
+    : out_(path, append ? std::ios::app : std::ios::trunc), path_(path) {
+  SHATTER_REQUIRE(out_, "cannot " << (append ? "open " : "create ") << path.string());
   out_ << std::setprecision(17);
+  if (append) return;
   for (size_t i = 0; i < columns.size(); ++i) out_ << (i ? "," : "") << columns[i];
   out_ << '\n';
 }

@@ -15,7 +15,9 @@ namespace shatter {
 /// so that a row read back is the same double.
 class CsvWriter {
  public:
-  CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns);
+  /// append: keep the file's rows (a restart; its header must be `columns`)
+  /// and add the new rows after them.
+  CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns, bool append = false);
   /// Start a row; add values with operator<<; end with end_row().
   CsvWriter& operator<<(double v);
   CsvWriter& operator<<(long v);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/checkpoint.hpp"
 #include "runtime/contact_stage.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
@@ -63,6 +64,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   compute_forces();
   update_ledger();
   total0_ = ledger_.total();
+  stable_dt0_ = stable_dt_;
   energy_scale_ = std::max(ledger_.kinetic + ledger_.strain, 1e-300);
   if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && !opt_.quiet)
     std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
@@ -218,6 +220,48 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   }
 }
 
+void Simulation::save_state(SimulationState& s) const {
+  s.step = step_;
+  s.time = time_;
+  s.dt = dt_;
+  s.stable_dt = stable_dt_;
+  s.x = x_;
+  s.v = v_;
+  s.a = a_;
+  s.f_int = f_int_;
+  s.f_ext = f_ext_;
+  s.reaction = reaction_;
+  s.ledger = ledger_;
+  s.total0 = total0_;
+  s.energy_scale = energy_scale_;
+}
+
+void Simulation::restore_state(const SimulationState& s) {
+  SHATTER_REQUIRE(!fracture_, "restore_state: the state of a scene with fracture (split nodes, cohesive elements) "
+                              "cannot be restored");
+  const size_t n = model_.mesh.num_nodes();
+  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
+                      s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
+                  "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
+                                                  << " reactions, the model " << n << " and " << bc_nodes_.size());
+  step_ = s.step;
+  time_ = s.time;
+  dt_ = s.dt;
+  stable_dt_ = s.stable_dt;
+  x_ = s.x;
+  v_ = s.v;
+  a_ = s.a;
+  f_int_ = s.f_int;
+  f_ext_ = s.f_ext;
+  reaction_ = s.reaction;
+  ledger_ = s.ledger;
+  total0_ = s.total0;
+  energy_scale_ = s.energy_scale;
+  last_elements_.strain_energy = s.ledger.strain;
+  last_elements_.stable_dt = s.stable_dt;
+  restored_ = true;
+}
+
 void Simulation::update_ledger() {
   const Index n = model_.mesh.num_nodes();
   const Momenta m = deterministic_sum(n, Momenta{}, [&](Index i) {
@@ -295,32 +339,77 @@ long Simulation::run() {
   long field_every = scene.output_every;
   if (field_every < 0) {
     // Default: about 20 frames over the run.
-    const double est_steps = scene.end_time / (scene.fixed_dt ? *scene.fixed_dt : stable_dt());
+    const double est_steps = scene.end_time / (scene.fixed_dt ? *scene.fixed_dt : scene.safety * stable_dt0_);
     field_every = std::max(1L, static_cast<long>(std::ceil(est_steps / 20)));
   }
   if (!opt_.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(opt_.out_dir, ec);
     if (ec) throw Error("cannot create the output folder " + opt_.out_dir.string() + ": " + ec.message());
+    // A restart keeps the rows up to its step and appends the rest.
+    if (restored_)
+      for (const char* csv : {"history.csv", "bodies.csv"}) truncate_rows_after(opt_.out_dir / csv, step_);
     history_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "history.csv",
         std::vector<std::string>{"step", "time", "dt", "kinetic", "strain", "cohesive_stored", "cohesive_dissipated",
                                  "contact_dissipated", "external_work", "total", "px", "py", "pz", "Lx", "Ly", "Lz",
-                                 "contacts", "cohesive_elements", "fragments", "contact_capped_steps"});
+                                 "contacts", "cohesive_elements", "fragments", "contact_capped_steps"},
+        restored_);
     bodies_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "bodies.csv",
-        std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"});
-    if (field_every > 0) fields_ = std::make_unique<FieldWriter>(opt_.out_dir, MPI_COMM_WORLD);
+        std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"}, restored_);
+    // A restart's frames go to OUTDIR/restart_<step>/; fields.h5 keeps the earlier ones.
+    const std::filesystem::path field_dir =
+        restored_ ? opt_.out_dir / ("restart_" + std::to_string(step_)) : opt_.out_dir;
+    if (field_every > 0) fields_ = std::make_unique<FieldWriter>(field_dir, MPI_COMM_WORLD);
   }
   Progress progress(scene.end_time, opt_.quiet);
-  write_outputs(field_every > 0);
+  if (!restored_) write_outputs(field_every > 0);
+  // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
+  // last good state when a step fails; not for scenes with fracture.
+  const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
+  const bool checkpoints = !opt_.out_dir.empty() && !fracture_;
+  SimulationState good;  // the state before the current step
+  auto last_checkpoint = std::chrono::steady_clock::now();
   const double tiny = 1e-12 * scene.end_time;
   while (time_ < scene.end_time - tiny) {
-    step();
+    if (checkpoints) save_state(good);
+    try {
+      step();
+    } catch (const Error& e) {
+      if (!checkpoints) throw;
+      progress.finish();
+      try {
+        write_checkpoint(checkpoint, model_, good, e.what());
+      } catch (const Error& w) {
+        throw Error(std::string(e.what()) + "\n" + w.what());
+      }
+      throw Error(std::string(e.what()) + "\nthe last good state (step " + std::to_string(good.step) +
+                  ") is in " + checkpoint.string() + ": continue from it with --restart " + checkpoint.string() +
+                  " and a smaller --set time.safety=...");
+    }
     const bool last = time_ >= scene.end_time - tiny;
     const bool field_row = field_every > 0 && (step_ % field_every == 0 || last);
     if (step_ % scene.history_every == 0 || last || field_row) write_outputs(field_row);
     progress.update(step_, time_, dt_, energy_error(), last);
+    const int stop = last ? 0 : stop_signal();
+    const auto now = std::chrono::steady_clock::now();
+    const std::optional<CheckpointSpec>& every = scene.checkpoint;
+    const bool due = every && ((every->every_steps > 0 && step_ % every->every_steps == 0) ||
+                               (every->every_seconds > 0 &&
+                                now - last_checkpoint >= std::chrono::duration<double>(every->every_seconds)));
+    if (checkpoints && (due || stop) && !last) {
+      save_state(good);
+      write_checkpoint(checkpoint, model_, good);
+      last_checkpoint = now;
+    }
+    if (stop) {
+      progress.finish();
+      const std::string where = checkpoints ? "; continue with --restart " + checkpoint.string()
+                                : fracture_ ? "; no checkpoint written (a scene with fracture cannot be restarted yet)"
+                                            : "; no checkpoint written (no output folder)";
+      throw Error("stopped by signal " + std::to_string(stop) + " after step " + std::to_string(step_) + where);
+    }
   }
   progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -48,6 +48,20 @@ struct Ledger {
   }
 };
 
+/// The complete state of a run between two steps (no fracture): what a
+/// checkpoint holds (runtime/checkpoint.hpp). Per-node arrays [n] in the
+/// model's node order; reaction [b] per node with a prescribed component, in
+/// node order.
+struct SimulationState {
+  long step = 0;
+  double time = 0, dt = 0;    ///< s: time reached, length of the last step
+  double stable_dt = 0;       ///< s: stable step of this state, without the safety factor
+  std::vector<Vec3> x, v, a;  ///< positions m, velocities m/s, accelerations m/s^2
+  std::vector<Vec3> f_int, f_ext, reaction;  ///< N
+  Ledger ledger;
+  double total0 = 0, energy_scale = 0;  ///< J: energy_error()'s reference
+};
+
 class Simulation {
  public:
   Simulation(Model& model, RunOptions options);
@@ -73,6 +87,14 @@ class Simulation {
   double element_loop_seconds() const { return element_seconds_; }
   const ContactStage* contact() const { return contact_.get(); }
   const FractureStage* fracture() const { return fracture_.get(); }
+
+  /// Copies the state between two steps into `state` (reusing its storage).
+  void save_state(SimulationState& state) const;
+  /// Continues from `state` (of this model, without fracture): the next
+  /// step() is the one the saved run would have taken, bitwise, and run()
+  /// appends to the outputs in opt.out_dir (checkpoint.hpp). Throws Error when
+  /// the array sizes do not match the model.
+  void restore_state(const SimulationState& state);
 
  private:
   void compute_forces();
@@ -101,6 +123,8 @@ class Simulation {
   std::vector<double> stress6_;             ///< per element Cauchy stress for the facet check (fracture only)
   std::unique_ptr<FieldWriter> fields_;
   std::unique_ptr<CsvWriter> history_, bodies_;
+  double stable_dt0_ = 0;  ///< stable step of the initial state (sets the default field interval)
+  bool restored_ = false;  ///< restore_state() was called: run() continues the outputs
   void apply_fracture();
   void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
   void write_fragments();

@@ -1,0 +1,391 @@
+#include "runtime/checkpoint.hpp"
+
+#include <fcntl.h>
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <array>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
+
+constexpr const char* kFormat = "shatter-checkpoint";
+constexpr long kVersion = 1;
+
+std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+/// Owns one HDF5 identifier and closes it with the matching H5?close.
+class H5Handle {
+ public:
+  H5Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5Handle(const H5Handle&) = delete;
+  H5Handle& operator=(const H5Handle&) = delete;
+  ~H5Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+/// Silences HDF5's error stack printing while alive: failures are reported
+/// by our own messages.
+class QuietHdf5 {
+ public:
+  QuietHdf5() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+// ---- writing: every failure throws Error naming the temporary file ----
+
+struct Writer {
+  std::string path;
+  void check(bool ok, const std::string& what) const {
+    SHATTER_REQUIRE(ok, "checkpoint " << path << ": HDF5 failed to " << what);
+  }
+  void attribute(hid_t object, const char* name, hid_t type, const void* value) const {
+    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+    H5Handle attr(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+    check(space.valid() && attr.valid() && H5Awrite(attr.get(), type, value) >= 0,
+          std::string("write attribute ") + name);
+  }
+  void number(hid_t object, const char* name, double v) const {
+    attribute(object, name, H5T_NATIVE_DOUBLE, &v);
+  }
+  void integer(hid_t object, const char* name, long v) const {
+    const std::int64_t w = v;
+    attribute(object, name, H5T_NATIVE_INT64, &w);
+  }
+  void text(hid_t object, const char* name, const std::string& s) const {
+    H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+    check(type.valid() && H5Tset_size(type.get(), s.size() + 1) >= 0, "make a string type");
+    attribute(object, name, type.get(), s.c_str());
+  }
+  void rows(hid_t group, const char* name, const std::vector<Vec3>& a) const {
+    const std::array<hsize_t, 2> dims{a.size(), 3};
+    H5Handle space(H5Screate_simple(2, dims.data(), nullptr), H5Sclose);
+    H5Handle dset(
+        H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+        H5Dclose);
+    check(space.valid() && dset.valid(), std::string("create dataset ") + name);
+    if (!a.empty())
+      check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
+            std::string("write dataset ") + name);
+    const std::uint64_t h = fnv1a(a.data(), a.size() * sizeof(Vec3));
+    attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &h);
+  }
+};
+
+/// fsync of a file or folder; throws naming it.
+void sync_path(const std::filesystem::path& p, int flags) {
+  const int fd = ::open(p.c_str(), flags);
+  SHATTER_REQUIRE(
+      fd >= 0, "checkpoint: cannot open " << p.string() << " to sync it: " << std::strerror(errno));
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  SHATTER_REQUIRE(rc == 0,
+                  "checkpoint: cannot sync " << p.string() << ": " << std::strerror(errno));
+}
+
+// ---- reading: every failure throws InputError naming the checkpoint ----
+
+struct Reader {
+  std::string path;
+  [[noreturn]] void fail(const std::string& why) const {
+    throw InputError("--restart " + path + ": " + why);
+  }
+  void require(bool ok, const std::string& why) const {
+    if (!ok) fail(why);
+  }
+  void attribute(hid_t object, const char* name, hid_t type, void* value) const {
+    H5Handle attr(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
+    require(attr.valid() && H5Aread(attr.get(), type, value) >= 0,
+            std::string("attribute ") + name +
+                " is missing or unreadable (truncated or corrupted checkpoint?)");
+  }
+  double number(hid_t object, const char* name) const {
+    double v = 0;
+    attribute(object, name, H5T_NATIVE_DOUBLE, &v);
+    return v;
+  }
+  long integer(hid_t object, const char* name) const {
+    std::int64_t v = 0;
+    attribute(object, name, H5T_NATIVE_INT64, &v);
+    return static_cast<long>(v);
+  }
+  std::string text(hid_t object, const char* name) const {
+    H5Handle attr(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
+    require(attr.valid(),
+            std::string("attribute ") + name + " is missing (not a shatter checkpoint?)");
+    H5Handle type(H5Aget_type(attr.get()), H5Tclose);
+    require(
+        type.valid() && H5Tget_class(type.get()) == H5T_STRING && !H5Tis_variable_str(type.get()),
+        std::string("attribute ") + name + " is not a string");
+    std::string s(H5Tget_size(type.get()), '\0');
+    require(H5Aread(attr.get(), type.get(), s.data()) >= 0,
+            std::string("cannot read attribute ") + name);
+    return s.c_str();
+  }
+  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected) const {
+    H5Handle dset(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
+    require(dset.valid(),
+            std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
+    H5Handle space(H5Dget_space(dset.get()), H5Sclose);
+    std::array<hsize_t, 2> dims{0, 0};
+    require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
+                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == 3 &&
+                dims[0] == expected,
+            std::string("dataset ") + name + " has the wrong shape (expected " +
+                std::to_string(expected) + " x 3)");
+    std::vector<Vec3> a(expected);
+    if (expected > 0)
+      require(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
+              std::string("cannot read dataset ") + name + " (truncated or corrupted checkpoint?)");
+    std::uint64_t h = 0;
+    attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &h);
+    require(h == fnv1a(a.data(), a.size() * sizeof(Vec3)),
+            std::string("dataset ") + name + " fails its hash check (corrupted checkpoint)");
+    return a;
+  }
+};
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+void record_stop_signal(int sig) {
+  g_stop_signal = sig;
+}
+
+}  // namespace
+
+std::uint64_t model_fingerprint(const Model& model) {
+  const Mesh& mesh = model.mesh;
+  std::uint64_t h = fnv1a(&mesh.order, sizeof mesh.order);
+  h = fnv1a(mesh.reference.data(), mesh.reference.size() * sizeof(Vec3), h);
+  h = fnv1a(mesh.conn.data(), mesh.conn.size() * sizeof(Index), h);
+  h = fnv1a(model.mass.data(), model.mass.size() * sizeof(double), h);
+  h = fnv1a(model.bc_mask.data(), model.bc_mask.size(), h);
+  return fnv1a(model.bc_velocity.data(), model.bc_velocity.size() * sizeof(Vec3), h);
+}
+
+void write_checkpoint(const std::filesystem::path& path, const Model& model,
+                      const SimulationState& s, const std::string& failure) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  const Writer w{tmp.string()};
+  const QuietHdf5 quiet;
+  {
+    H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    // Version 2 object headers and superblock: HDF5 checksums all metadata.
+    w.check(
+        fapl.valid() && H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST) >= 0,
+        "select the latest file format");
+    H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
+    w.check(file.valid(), "create the file");
+    H5Handle root_group(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose);
+    w.check(root_group.valid(), "open the root group");
+    const hid_t root = root_group.get();
+    w.text(root, "format", kFormat);
+    w.integer(root, "version", kVersion);
+    w.text(root, "scene", model.scene.name);
+    w.integer(root, "nodes", model.mesh.num_nodes());
+    w.integer(root, "elements", model.mesh.num_elements());
+    w.integer(root, "order", model.mesh.order);
+    const std::uint64_t fp = model_fingerprint(model);
+    w.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &fp);
+    w.integer(root, "step", s.step);
+    w.number(root, "time", s.time);
+    w.number(root, "dt", s.dt);
+    w.number(root, "stable_dt", s.stable_dt);
+    w.number(root, "total0", s.total0);
+    w.number(root, "energy_scale", s.energy_scale);
+    w.text(root, "failure", failure);
+
+    H5Handle state(H5Gcreate2(root, "state", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    w.check(state.valid(), "create group /state");
+    w.rows(state.get(), "positions", s.x);
+    w.rows(state.get(), "velocities", s.v);
+    w.rows(state.get(), "accelerations", s.a);
+    w.rows(state.get(), "internal_forces", s.f_int);
+    w.rows(state.get(), "external_forces", s.f_ext);
+    w.rows(state.get(), "reactions", s.reaction);
+
+    H5Handle ledger(H5Gcreate2(root, "ledger", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    w.check(ledger.valid(), "create group /ledger");
+    const Ledger& l = s.ledger;
+    const hid_t g = ledger.get();
+    w.number(g, "kinetic", l.kinetic);
+    w.number(g, "strain", l.strain);
+    w.number(g, "cohesive_stored", l.cohesive_stored);
+    w.number(g, "cohesive_dissipated", l.cohesive_dissipated);
+    w.number(g, "contact_dissipated", l.contact_dissipated);
+    w.number(g, "external_work", l.external_work);
+    const char* p_names[3] = {"px", "py", "pz"};
+    const char* L_names[3] = {"Lx", "Ly", "Lz"};
+    for (int c = 0; c < 3; ++c) {
+      w.number(g, p_names[c], l.momentum[c]);
+      w.number(g, L_names[c], l.angular_momentum[c]);
+    }
+    w.integer(g, "contacts", l.contacts);
+    w.integer(g, "cohesive_elements", l.cohesive_elements);
+    w.integer(g, "fragments", l.fragments);
+    w.integer(g, "contact_capped_steps", l.contact_capped_steps);
+    w.check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL) >= 0, "flush the file");
+  }  // closed here: everything is in the OS's hands
+  sync_path(tmp, O_RDONLY);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  SHATTER_REQUIRE(!ec, "checkpoint: cannot rename " << tmp.string() << " to " << path.string()
+                                                    << ": " << ec.message());
+  const std::filesystem::path dir =
+      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  sync_path(dir, O_RDONLY | O_DIRECTORY);
+}
+
+SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model) {
+  const Reader r{path.string()};
+  if (model.scene.fracture_enabled())
+    r.fail(
+        "restart of a scene with fracture is not implemented: a checkpoint does not hold the split "
+        "nodes, cohesive elements and fragments, so the run could not continue to the same answer");
+  r.require(std::filesystem::is_regular_file(path), "no such file");
+  const QuietHdf5 quiet;
+  r.require(H5Fis_hdf5(path.c_str()) > 0,
+            "not a readable HDF5 file (truncated or corrupted checkpoint?)");
+  // STRONG: closing the file closes whatever a corrupted file left open.
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  r.require(fapl.valid() && H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) >= 0,
+            "HDF5 failed to set up");
+  H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose);
+  r.require(file.valid(), "cannot open the HDF5 file (truncated or corrupted checkpoint?)");
+  H5Handle root_group(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose);
+  r.require(root_group.valid(), "cannot open the root group (truncated or corrupted checkpoint?)");
+  const hid_t root = root_group.get();
+  r.require(r.text(root, "format") == kFormat, "not a shatter checkpoint");
+  r.require(r.integer(root, "version") == kVersion,
+            "checkpoint format version " + std::to_string(r.integer(root, "version")) +
+                ", this shatter reads " + std::to_string(kVersion));
+  const std::string scene = r.text(root, "scene");
+  r.require(scene == model.scene.name, "the checkpoint is of scene '" + scene + "', not of '" +
+                                           model.scene.name + "' (" + model.scene.file + ")");
+  const long nodes = r.integer(root, "nodes"), elements = r.integer(root, "elements"),
+             order = r.integer(root, "order");
+  if (nodes != model.mesh.num_nodes() || elements != model.mesh.num_elements() ||
+      order != model.mesh.order) {
+    std::ostringstream os;
+    os << "the checkpoint's model has " << nodes << " nodes and " << elements << " TET"
+       << (order == 2 ? 10 : 4) << " elements, the scene's has " << model.mesh.num_nodes()
+       << " nodes and " << model.mesh.num_elements() << " TET" << model.mesh.nodes_per_element()
+       << " elements (another mesh: element_size, shape or order changed?)";
+    r.fail(os.str());
+  }
+  std::uint64_t fp = 0;
+  r.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &fp);
+  r.require(fp == model_fingerprint(model),
+            "the model differs from the checkpoint's (mesh coordinates, masses or boundary "
+            "conditions changed)");
+
+  SimulationState s;
+  s.step = r.integer(root, "step");
+  s.time = r.number(root, "time");
+  s.dt = r.number(root, "dt");
+  s.stable_dt = r.number(root, "stable_dt");
+  s.total0 = r.number(root, "total0");
+  s.energy_scale = r.number(root, "energy_scale");
+  H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);
+  r.require(state.valid(), "group /state is missing (truncated or corrupted checkpoint?)");
+  const std::size_t n = model.mesh.num_nodes();
+  std::size_t b = 0;
+  for (std::uint8_t m : model.bc_mask) b += m != 0;
+  s.x = r.rows(state.get(), "positions", n);
+  s.v = r.rows(state.get(), "velocities", n);
+  s.a = r.rows(state.get(), "accelerations", n);
+  s.f_int = r.rows(state.get(), "internal_forces", n);
+  s.f_ext = r.rows(state.get(), "external_forces", n);
+  s.reaction = r.rows(state.get(), "reactions", b);
+
+  H5Handle ledger(H5Gopen2(root, "ledger", H5P_DEFAULT), H5Gclose);
+  r.require(ledger.valid(), "group /ledger is missing (truncated or corrupted checkpoint?)");
+  const hid_t g = ledger.get();
+  Ledger& l = s.ledger;
+  l.kinetic = r.number(g, "kinetic");
+  l.strain = r.number(g, "strain");
+  l.cohesive_stored = r.number(g, "cohesive_stored");
+  l.cohesive_dissipated = r.number(g, "cohesive_dissipated");
+  l.contact_dissipated = r.number(g, "contact_dissipated");
+  l.external_work = r.number(g, "external_work");
+  const char* p_names[3] = {"px", "py", "pz"};
+  const char* L_names[3] = {"Lx", "Ly", "Lz"};
+  for (int c = 0; c < 3; ++c) {
+    l.momentum[c] = r.number(g, p_names[c]);
+    l.angular_momentum[c] = r.number(g, L_names[c]);
+  }
+  l.contacts = r.integer(g, "contacts");
+  l.cohesive_elements = r.integer(g, "cohesive_elements");
+  l.fragments = r.integer(g, "fragments");
+  l.contact_capped_steps = r.integer(g, "contact_capped_steps");
+  return s;
+}
+
+void truncate_rows_after(const std::filesystem::path& csv, long step) {
+  std::ifstream in(csv);
+  if (!in)
+    throw InputError("--restart: " + csv.string() +
+                     " is missing; it is needed to continue the run's rows");
+  std::string header, line, kept;
+  if (!std::getline(in, header) || header.rfind("step,", 0) != 0)
+    throw InputError("--restart: " + csv.string() + " has no header row starting with 'step,'");
+  kept = header + '\n';
+  while (std::getline(in, line)) {
+    // A row cut short by a kill has no newline and no trustworthy step: dropped with the rest.
+    if (in.eof()) break;
+    if (std::stol(line.substr(0, line.find(','))) > step) break;
+    kept += line + '\n';
+  }
+  in.close();
+  const std::filesystem::path tmp = csv.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << kept;
+    SHATTER_REQUIRE(out.flush(), "cannot write " << tmp.string());
+  }
+  std::filesystem::rename(tmp, csv);
+}
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = record_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;  // a second signal of the same kind ends the process at once
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int stop_signal() {
+  return g_stop_signal;
+}
+
+}  // namespace shatter

@@ -1,0 +1,80 @@
+#pragma once
+// Checkpoint and restart (SCENE.md "checkpoint:", DESIGN.md "Inputs and
+// outputs"): the complete state of a run between two steps in one HDF5 file,
+// written atomically, read back into a Simulation of the same model so that
+// the continued run is bitwise the run that was never stopped.
+//
+// Layout of checkpoint.h5 (n = nodes, b = nodes with a prescribed component,
+// in the order of Model::bc_mask; file format "latest", so every object header
+// carries the HDF5 metadata checksum):
+//   /  attributes
+//       format        string "shatter-checkpoint"
+//       version       int64 1
+//       scene         string, Scene::name
+//       nodes         int64 n
+//       elements      int64
+//       order         int64, 1 = TET4, 2 = TET10
+//       fingerprint   uint64, model_fingerprint() of the model written
+//       step          int64, steps done
+//       time, dt      float64, s: time reached, length of the last step
+//       stable_dt     float64, s: stable step of the state, no safety factor
+//       total0, energy_scale   float64, J: Simulation::energy_error() reference
+//       failure       string: empty, or the error that stopped the run one
+//                     step after this (good) state
+//   /state/positions, velocities, accelerations, internal_forces,
+//          external_forces      n x 3 float64 (m, m/s, m/s^2, N, N)
+//   /state/reactions            b x 3 float64, N
+//       each dataset has attribute fnv1a64 (uint64): FNV-1a hash of its bytes,
+//       so a flipped byte in the raw data is found too
+//   /ledger  attributes: the Ledger fields by their history.csv names
+//       (float64 kinetic ... external_work, px py pz, Lx Ly Lz; int64 contacts,
+//       cohesive_elements, fragments, contact_capped_steps)
+//
+// Contact needs nothing more: its surface is rebuilt from the mesh and its
+// pair lists are scratch of one step. Fracture (split nodes, cohesive
+// elements) is not saved: scenes with fracture are refused.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "runtime/model.hpp"
+#include "runtime/simulation.hpp"
+
+namespace shatter {
+
+/// FNV-1a hash over what fixes the answer of a model besides its scene
+/// name: reference coordinates, connectivity, lumped masses, prescribed
+/// velocities and their masks. Scene keys that do not change the model
+/// (time.safety, time.end, output, checkpoint) may differ at a restart.
+std::uint64_t model_fingerprint(const Model& model);
+
+/// Writes `state` of a run of `model` to `path` atomically: `path`.tmp is
+/// written, flushed and fsync'ed, then renamed over `path` (and the folder
+/// fsync'ed), so `path` is always either the previous checkpoint or this one.
+/// `failure`: empty, or the message of the error the step after `state` threw.
+/// Throws shatter::Error naming the path when HDF5 or the file system fails;
+/// `path` is then untouched.
+void write_checkpoint(const std::filesystem::path& path, const Model& model,
+                      const SimulationState& state, const std::string& failure = "");
+
+/// Reads a checkpoint of `model` written by write_checkpoint. Throws
+/// InputError naming the path and the reason when the file is missing,
+/// truncated or corrupted (HDF5 or hash check), of another scene or model
+/// (name, counts, fingerprint), or when the scene has fracture (topology and
+/// cohesive state are not saved).
+SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model);
+
+/// Removes the rows of a CSV file whose first column (step) is above `step`,
+/// so that a restarted run appends its rows to it without duplicating any.
+/// Throws InputError when the file is missing or has no header.
+void truncate_rows_after(const std::filesystem::path& csv, long step);
+
+/// Installs handlers for SIGINT and SIGTERM that only record the signal (the
+/// time loop checkpoints and stops after the current step); a second signal of
+/// the same kind gets the default action (ends the process at once).
+void install_stop_handlers();
+
+/// The signal received since install_stop_handlers(), or 0.
+int stop_signal();
+
+}  // namespace shatter

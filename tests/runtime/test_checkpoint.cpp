@@ -1,0 +1,459 @@
+// Checkpoint and restart (runtime/checkpoint.hpp):
+//   - N steps, checkpoint, a fresh Simulation restored from it, M more steps:
+//     positions, velocities and ledger bitwise equal to N + M steps without a
+//     stop (a free body with boundary conditions and gravity; a contact scene);
+//   - truncated, byte-corrupted, other-scene and other-mesh checkpoints and
+//     scenes with fracture are refused with a message naming the reason;
+//   - a write that fails leaves the previous checkpoint intact;
+//   - the binary: SIGTERM mid-run exits 1 and leaves a checkpoint, --restart
+//     from it gives the history.csv and bodies.csv of a run never stopped; a
+//     run that fails (inverted elements) leaves the last good state.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "kernels/error.hpp"
+#include "runtime/checkpoint.hpp"
+#include "runtime/model.hpp"
+#include "runtime/simulation.hpp"
+#include "scene_text.hpp"
+
+using namespace shatter;
+using shatter::test::scene_from_text;
+using shatter::test::write_scene;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kMaterials =
+    "materials:\n"
+    "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n";
+
+/// A spinning, stretching block, one face held in z, under gravity: every
+/// part of the state (reactions, external work) is in play.
+std::string free_scene(const std::string& name, const std::string& element_size = "0.004") {
+  return "name: " + name + "\ntime: {end: 1.0}\n" + kMaterials +
+         "bodies:\n"
+         "  - name: b\n"
+         "    material: steel\n"
+         "    mesh: {shape: box, size: [0.02, 0.01, 0.01], element_size: " +
+         element_size +
+         "}\n"
+         "    initial_velocity: [3, -1, 2]\n"
+         "    angular_velocity: [200, 500, -300]\n"
+         "    velocity_gradient: [[30, 5, 0], [0, -20, 8], [1, 0, 10]]\n"
+         "boundary_conditions:\n"
+         "  - {body: b, region: {box: [[-1, -1, -1], [1, 1, -0.004999]]}, velocity: [null, null, "
+         "1.0]}\n"
+         "gravity: [0, 0, -9.81]\n";
+}
+
+/// A block thrown onto a held plate with friction.
+std::string contact_scene(const std::string& name) {
+  return "name: " + name + "\ntime: {end: 1.0}\n" + kMaterials +
+         "bodies:\n"
+         "  - {name: plate, material: steel, mesh: {shape: box, size: [0.06, 0.03, 0.01], center: "
+         "[0, 0, -0.005], "
+         "element_size: 0.006}}\n"
+         "  - {name: block, material: steel, mesh: {shape: box, size: [0.01, 0.01, 0.01], center: "
+         "[0, 0, 0.005001], "
+         "element_size: 0.005}, initial_velocity: [5, 0, -5]}\n"
+         "boundary_conditions:\n"
+         "  - {body: plate, region: {box: [[-1, -1, -1], [1, 1, -0.00999]]}, velocity: [0, 0, 0]}\n"
+         "gravity: [0, 0, -9.81]\n"
+         "contact: {friction: 0.3, restitution: 0.5}\n";
+}
+
+fs::path test_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "shatter_test_checkpoint" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool bitwise_equal(std::span<const Vec3> a, std::span<const Vec3> b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+
+void expect_same_ledger(const Ledger& a, const Ledger& b) {
+  EXPECT_EQ(a.kinetic, b.kinetic);
+  EXPECT_EQ(a.strain, b.strain);
+  EXPECT_EQ(a.cohesive_stored, b.cohesive_stored);
+  EXPECT_EQ(a.cohesive_dissipated, b.cohesive_dissipated);
+  EXPECT_EQ(a.contact_dissipated, b.contact_dissipated);
+  EXPECT_EQ(a.external_work, b.external_work);
+  EXPECT_TRUE(a.momentum == b.momentum);
+  EXPECT_TRUE(a.angular_momentum == b.angular_momentum);
+  EXPECT_EQ(a.contacts, b.contacts);
+  EXPECT_EQ(a.cohesive_elements, b.cohesive_elements);
+  EXPECT_EQ(a.fragments, b.fragments);
+  EXPECT_EQ(a.contact_capped_steps, b.contact_capped_steps);
+}
+
+/// N steps, checkpoint to a file, restore into a fresh model and Simulation,
+/// M more steps; against N + M steps without a stop.
+void expect_bitwise_continuation(const std::string& name, const std::string& yaml, int n, int m,
+                                 long* contacts_seen = nullptr) {
+  const Scene scene = scene_from_text(name, yaml);
+  Model whole_model = build_model(scene);
+  Simulation whole(whole_model, {});
+  long contacts = 0;
+  for (int s = 0; s < n + m; ++s) {
+    whole.step();
+    contacts = std::max(contacts, whole.ledger().contacts);
+  }
+  if (contacts_seen) *contacts_seen = contacts;
+
+  const fs::path file = test_dir(name) / "checkpoint.h5";
+  {
+    Model first_model = build_model(scene);
+    Simulation first(first_model, {});
+    for (int s = 0; s < n; ++s) first.step();
+    SimulationState state;
+    first.save_state(state);
+    write_checkpoint(file, first_model, state);
+  }
+  Model second_model = build_model(scene);
+  Simulation second(second_model, {});
+  second.restore_state(read_checkpoint(file, second_model));
+  EXPECT_EQ(second.steps(), n);
+  for (int s = 0; s < m; ++s) second.step();
+
+  EXPECT_EQ(second.steps(), whole.steps());
+  EXPECT_EQ(second.time(), whole.time());
+  EXPECT_EQ(second.dt(), whole.dt());
+  EXPECT_EQ(second.stable_dt(), whole.stable_dt());
+  EXPECT_EQ(second.energy_error(), whole.energy_error());
+  EXPECT_TRUE(bitwise_equal(second.positions(), whole.positions()));
+  EXPECT_TRUE(bitwise_equal(second.velocities(), whole.velocities()));
+  EXPECT_TRUE(bitwise_equal(second.internal_forces(), whole.internal_forces()));
+  expect_same_ledger(second.ledger(), whole.ledger());
+}
+
+/// A checkpoint of `yaml` after `steps` steps, written to `file`.
+void checkpoint_after(const std::string& name, const std::string& yaml, int steps,
+                      const fs::path& file) {
+  Model model = build_model(scene_from_text(name, yaml));
+  Simulation sim(model, {});
+  for (int s = 0; s < steps; ++s) sim.step();
+  SimulationState state;
+  sim.save_state(state);
+  write_checkpoint(file, model, state);
+}
+
+/// The message of the InputError read_checkpoint throws, or "" when it loads.
+std::string refusal(const fs::path& file, const Model& model) {
+  try {
+    read_checkpoint(file, model);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+struct Child {
+  pid_t pid = -1;
+  fs::path log;
+};
+
+/// Starts the shatter binary with `args`, stdout and stderr to `log`.
+Child start_shatter(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv{std::string(SHATTER_BINARY_DIR) + "/apps/shatter"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  Child c;
+  c.log = log;
+  EXPECT_EQ(posix_spawn(&c.pid, cargv[0], &actions, nullptr, cargv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  return c;
+}
+
+/// Waits for the child; returns its exit status (-1 when killed by a signal).
+int finish(const Child& c) {
+  int st = 0;
+  EXPECT_EQ(waitpid(c.pid, &st, 0), c.pid);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+long count_lines(const fs::path& p) {
+  std::ifstream in(p);
+  long n = 0;
+  std::string line;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(Checkpoint, RestoredRunIsBitwiseTheUninterruptedOne) {
+  expect_bitwise_continuation("ckpt_free", free_scene("ckpt_free"), 37, 41);
+}
+
+TEST(Checkpoint, RestoredContactRunIsBitwiseTheUninterruptedOne) {
+  long contacts = 0;
+  expect_bitwise_continuation("ckpt_contact", contact_scene("ckpt_contact"), 60, 80, &contacts);
+  EXPECT_GT(contacts, 0) << "the scene must be in contact after the checkpoint";
+}
+
+TEST(Checkpoint, TruncatedFileIsRefused) {
+  const fs::path dir = test_dir("truncated");
+  const fs::path good = dir / "checkpoint.h5", cut = dir / "cut.h5";
+  checkpoint_after("ckpt_trunc", free_scene("ckpt_trunc"), 5, good);
+  const std::string bytes = slurp(good);
+  Model model = build_model(scene_from_text("ckpt_trunc", free_scene("ckpt_trunc")));
+  for (double keep : {0.0, 0.3, 0.9, 0.999}) {
+    std::ofstream(cut, std::ios::binary)
+        << bytes.substr(0, static_cast<size_t>(keep * bytes.size()));
+    const std::string why = refusal(cut, model);
+    EXPECT_NE(why.find("--restart " + cut.string()), std::string::npos) << why;
+    EXPECT_NE(why.find("corrupted"), std::string::npos) << "kept " << keep << ": " << why;
+  }
+}
+
+// A flipped byte in the raw data fails the dataset hash; a flipped byte
+// anywhere is either refused or leaves the state read unchanged (unused bytes).
+TEST(Checkpoint, CorruptedBytesAreRefusedOrHarmless) {
+  const fs::path dir = test_dir("corrupted");
+  const fs::path good = dir / "checkpoint.h5", bad = dir / "bad.h5";
+  checkpoint_after("ckpt_corrupt", free_scene("ckpt_corrupt"), 5, good);
+  Model model = build_model(scene_from_text("ckpt_corrupt", free_scene("ckpt_corrupt")));
+  const SimulationState ref = read_checkpoint(good, model);
+  const std::string bytes = slurp(good);
+
+  haddr_t velocity_offset = HADDR_UNDEF;
+  {
+    const hid_t f = H5Fopen(good.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t d = H5Dopen2(f, "/state/velocities", H5P_DEFAULT);
+    velocity_offset = H5Dget_offset(d);
+    H5Dclose(d);
+    H5Fclose(f);
+  }
+  ASSERT_NE(velocity_offset, HADDR_UNDEF);
+  std::string flipped = bytes;
+  flipped[velocity_offset + 8 * 7 + 3] ^= 0x10;
+  std::ofstream(bad, std::ios::binary) << flipped;
+  const std::string why = refusal(bad, model);
+  EXPECT_NE(why.find("velocities fails its hash check"), std::string::npos) << why;
+
+  int refused = 0, harmless = 0;
+  for (size_t at = 0; at < bytes.size(); at += 61) {
+    flipped = bytes;
+    flipped[at] ^= 0x5a;
+    std::ofstream(bad, std::ios::binary | std::ios::trunc) << flipped;
+    try {
+      const SimulationState s = read_checkpoint(bad, model);
+      ++harmless;
+      EXPECT_EQ(s.step, ref.step) << "byte " << at;
+      EXPECT_EQ(s.time, ref.time) << "byte " << at;
+      EXPECT_EQ(s.dt, ref.dt) << "byte " << at;
+      EXPECT_EQ(s.stable_dt, ref.stable_dt) << "byte " << at;
+      EXPECT_EQ(s.ledger.kinetic, ref.ledger.kinetic) << "byte " << at;
+      EXPECT_EQ(s.ledger.external_work, ref.ledger.external_work) << "byte " << at;
+      EXPECT_TRUE(bitwise_equal(s.x, ref.x) && bitwise_equal(s.v, ref.v) &&
+                  bitwise_equal(s.a, ref.a) && bitwise_equal(s.reaction, ref.reaction))
+          << "byte " << at;
+    } catch (const InputError&) {
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0)
+      << "a refused file left HDF5 objects open";
+  std::printf("flipped bytes: %d refused, %d harmless\n", refused, harmless);
+}
+
+TEST(Checkpoint, CheckpointOfAnotherModelIsRefused) {
+  const fs::path file = test_dir("other") / "checkpoint.h5";
+  checkpoint_after("ckpt_other", free_scene("ckpt_other"), 3, file);
+
+  Model renamed = build_model(scene_from_text("ckpt_renamed", free_scene("ckpt_renamed")));
+  EXPECT_NE(refusal(file, renamed).find("of scene 'ckpt_other', not of 'ckpt_renamed'"),
+            std::string::npos)
+      << refusal(file, renamed);
+
+  Model finer = build_model(scene_from_text("ckpt_other", free_scene("ckpt_other", "0.003")));
+  EXPECT_NE(refusal(file, finer).find("nodes and"), std::string::npos) << refusal(file, finer);
+
+  std::string yaml = free_scene("ckpt_other");
+  yaml.replace(yaml.find("density: 7850"), 13, "density: 7851");
+  Model heavier = build_model(scene_from_text("ckpt_other", yaml));
+  EXPECT_NE(refusal(file, heavier).find("model differs"), std::string::npos)
+      << refusal(file, heavier);
+
+  // time.safety and time.end may change at a restart.
+  yaml = free_scene("ckpt_other");
+  yaml.replace(yaml.find("time: {end: 1.0}"), 16, "time: {end: 2.0, safety: 0.3}");
+  Model safer = build_model(scene_from_text("ckpt_other", yaml));
+  EXPECT_EQ(refusal(file, safer), "");
+
+  EXPECT_NE(refusal(file.parent_path() / "missing.h5", safer).find("no such file"),
+            std::string::npos);
+}
+
+TEST(Checkpoint, SceneWithFractureIsRefusedNamingTheLimitation) {
+  const fs::path file = test_dir("fracture") / "checkpoint.h5";
+  checkpoint_after("ckpt_fracture", free_scene("ckpt_fracture"), 3, file);
+  std::string yaml = free_scene("ckpt_fracture");
+  yaml.replace(yaml.find("poisson_ratio: 0.3}"), 19,
+               "poisson_ratio: 0.3, fracture: {strength: 1.0e9, energy: 100.0}}");
+  Model model = build_model(scene_from_text("ckpt_fracture", yaml));
+  const std::string why = refusal(file, model);
+  EXPECT_NE(why.find("fracture is not implemented"), std::string::npos) << why;
+}
+
+// A write that fails (here: the temporary file cannot be created) throws and
+// leaves the previous checkpoint as it was.
+TEST(Checkpoint, FailedWriteLeavesThePreviousCheckpoint) {
+  const fs::path dir = test_dir("failed_write");
+  const fs::path file = dir / "checkpoint.h5";
+  checkpoint_after("ckpt_failed", free_scene("ckpt_failed"), 4, file);
+  const std::string before = slurp(file);
+
+  Model model = build_model(scene_from_text("ckpt_failed", free_scene("ckpt_failed")));
+  Simulation sim(model, {});
+  for (int s = 0; s < 9; ++s) sim.step();
+  SimulationState state;
+  sim.save_state(state);
+  fs::create_directories(dir / "checkpoint.h5.tmp");  // blocks the temporary file
+  EXPECT_THROW(write_checkpoint(file, model, state), Error);
+  EXPECT_EQ(slurp(file), before);
+  EXPECT_EQ(read_checkpoint(file, model).step, 4);
+
+  // A stale temporary file from a crash is simply replaced by the next write.
+  fs::remove_all(dir / "checkpoint.h5.tmp");
+  std::ofstream(dir / "checkpoint.h5.tmp") << "half a checkpoint";
+  write_checkpoint(file, model, state);
+  EXPECT_EQ(read_checkpoint(file, model).step, 9);
+  EXPECT_FALSE(fs::exists(dir / "checkpoint.h5.tmp"));
+}
+
+TEST(Checkpoint, TruncateRowsAfterKeepsRowsUpToTheStep) {
+  const fs::path csv = test_dir("rows") / "history.csv";
+  std::ofstream(csv) << "step,time\n0,0\n5,1\n10,2\n15,3\n20,4";  // the last row cut by a kill
+  truncate_rows_after(csv, 10);
+  EXPECT_EQ(slurp(csv), "step,time\n0,0\n5,1\n10,2\n");
+}
+
+// The binary: SIGTERM or SIGKILL mid-run, --restart, and the same rows as a run never stopped.
+TEST(CheckpointRun, StoppedThenRestartedRunGivesTheUninterruptedHistory) {
+  const fs::path dir = test_dir("sigterm");
+  const std::string scene = write_scene(
+      "ckpt_sigterm",
+      "name: ckpt_sigterm\ntime: {end: 4.0e-5}\n" + kMaterials +
+          "output: {every: 200, history_every: 3}\n"
+          "bodies:\n"
+          "  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.01, 0.01], "
+          "element_size: 0.0015}, initial_velocity: [1, 0, 0], angular_velocity: [0, 0, 300]}\n"
+          "boundary_conditions:\n"
+          "  - {body: b, region: {box: [[-1, -1, -1], [1, 1, -0.004999]]}, velocity: [null, null, "
+          "0.5]}\n"
+          "checkpoint: {every_steps: 40}\n");
+  const fs::path whole = dir / "whole";
+  const Child reference = start_shatter(
+      {"run", scene, "--out", whole.string(), "--threads", "1", "--quiet"}, dir / "whole.log");
+  ASSERT_EQ(finish(reference), 0) << slurp(dir / "whole.log");
+  const long rows = count_lines(whole / "history.csv");
+  ASSERT_GT(rows, 100);
+
+  // SIGTERM: the run checkpoints and exits 1. SIGKILL (a crash): the periodic
+  // checkpoint remains, and the rows written after it are dropped at the restart.
+  for (const int sig : {SIGTERM, SIGKILL}) {
+    const fs::path stopped = dir / ("stopped_" + std::to_string(sig));
+    const fs::path log_file = dir / ("stopped_" + std::to_string(sig) + ".log");
+    const Child run = start_shatter(
+        {"run", scene, "--out", stopped.string(), "--threads", "1", "--quiet"}, log_file);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (count_lines(stopped / "history.csv") < rows / 4 &&
+           std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    kill(run.pid, sig);
+    const int status = finish(run);
+    const std::string log = slurp(log_file);
+    if (sig == SIGTERM) {
+      EXPECT_EQ(status, 1) << log;
+      EXPECT_NE(log.find("stopped by signal " + std::to_string(SIGTERM)), std::string::npos) << log;
+    } else {
+      EXPECT_EQ(status, -1) << log;
+    }
+    ASSERT_TRUE(fs::exists(stopped / "checkpoint.h5")) << log;
+    EXPECT_LT(count_lines(stopped / "history.csv"), rows)
+        << "the signal came after the end; make the scene longer";
+    Model model = build_model(load_scene(scene));
+    const long step = read_checkpoint(stopped / "checkpoint.h5", model).step;
+    EXPECT_GT(step, 0);
+    if (sig == SIGKILL) {
+      EXPECT_EQ(step % 40, 0);
+    }
+
+    const fs::path again_log = dir / ("again_" + std::to_string(sig) + ".log");
+    const Child again =
+        start_shatter({"run", scene, "--restart", (stopped / "checkpoint.h5").string(), "--threads",
+                       "2", "--quiet"},
+                      again_log);
+    ASSERT_EQ(finish(again), 0) << slurp(again_log);
+    EXPECT_EQ(slurp(stopped / "history.csv"), slurp(whole / "history.csv")) << "signal " << sig;
+    EXPECT_EQ(slurp(stopped / "bodies.csv"), slurp(whole / "bodies.csv")) << "signal " << sig;
+    EXPECT_TRUE(fs::exists(stopped / ("restart_" + std::to_string(step)) / "fields.h5"));
+  }
+}
+
+TEST(CheckpointRun, RestartOfAnotherSceneExitsTwo) {
+  const fs::path dir = test_dir("restart_other");
+  const std::string scene = write_scene("ckpt_cli_other", free_scene("ckpt_cli_other"));
+  checkpoint_after("ckpt_cli_source", free_scene("ckpt_cli_source"), 2, dir / "checkpoint.h5");
+  const Child c = start_shatter(
+      {"run", scene, "--restart", (dir / "checkpoint.h5").string(), "--quiet"}, dir / "log");
+  EXPECT_EQ(finish(c), 2);
+  EXPECT_NE(slurp(dir / "log").find("of scene 'ckpt_cli_source'"), std::string::npos)
+      << slurp(dir / "log");
+}
+
+// A time step far above the stable one inverts elements: exit 1, and the
+// checkpoint holds the last good state with the error.
+TEST(CheckpointRun, FailedRunLeavesTheLastGoodState) {
+  const fs::path dir = test_dir("failure");
+  const std::string yaml =
+      "name: ckpt_blowup\ntime: {end: 1.0e-3, dt: 2.0e-6}\n" + kMaterials +
+      "output: {every: 0}\n"
+      "bodies:\n"
+      "  - {name: b, material: steel, mesh: {shape: box, size: [0.01, 0.01, 0.01], "
+      "element_size: 0.005}, velocity_gradient: [[100, 0, 0], [0, 0, 0], [0, 0, 0]]}\n";
+  const std::string scene = write_scene("ckpt_blowup", yaml);
+  const Child c = start_shatter({"run", scene, "--out", dir.string(), "--threads", "1", "--quiet"},
+                                dir / "log");
+  EXPECT_EQ(finish(c), 1);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("the last good state (step "), std::string::npos) << log;
+  Model model = build_model(load_scene(scene));
+  const SimulationState s = read_checkpoint(dir / "checkpoint.h5", model);
+  // The history's last row is the checkpoint's step: the failing step wrote nothing.
+  std::ifstream in(dir / "history.csv");
+  std::string line, last_row;
+  while (std::getline(in, line)) last_row = line;
+  EXPECT_EQ(std::stol(last_row.substr(0, last_row.find(','))), s.step) << log;
+  for (const Vec3& x : s.x) EXPECT_TRUE(x.allFinite());
+}
