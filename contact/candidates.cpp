@@ -86,6 +86,15 @@ std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e
   return ContactPair{ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}};
 }
 
+bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+  const auto& n = pair.nodes;
+  if (pair.kind == ContactPair::VertexFace)
+    return boxes_overlap(swept_box(std::array<Index, 1>{n[0]}, x_old, x_new),
+                         swept_box(std::array<Index, 3>{n[1], n[2], n[3]}, x_old, x_new));
+  return boxes_overlap(swept_box(std::array<Index, 2>{n[0], n[1]}, x_old, x_new),
+                       swept_box(std::array<Index, 2>{n[2], n[3]}, x_old, x_new));
+}
+
 void canonicalize(ContactPairs& pairs) {
   tbb::parallel_sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());

@@ -42,6 +42,11 @@ std::optional<ContactPair> vertex_face_pair(const ContactSurface& surface, Index
 /// e0 < e1, f0 < f1, (e0, e1) < (f0, f1); none when the edges share a node.
 std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e, Index f);
 
+/// Whether the swept boxes (as swept_boxes makes them) of the two primitives of
+/// `pair` overlap: the test find_candidates applies, for one pair. Filtering a
+/// superset of candidates with it gives exactly find_candidates' list.
+bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new);
+
 /// Sort by ContactPair's operator< and drop duplicates (oneTBB parallel sort
 /// on a total order: the result does not depend on the thread count).
 void canonicalize(ContactPairs& pairs);

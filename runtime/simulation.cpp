@@ -470,6 +470,7 @@ void Simulation::write_summary(double wall) {
   if (fracture_) j.add("fracture_check_time", fracture_->check_seconds());
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());
+    j.add("contact_searches", contact_->searches());
     j.add("contact_dcr_time", contact_->dcr_seconds());
     j.add("contact_surface_triangles", static_cast<long>(contact_->surface().num_triangles()));
   }
