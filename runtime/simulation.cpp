@@ -93,7 +93,6 @@ void Simulation::compute_forces() {
   if (!(last_elements_.min_jacobian > 0)) {
     const Index e = last_elements_.worst_element;
     Vec3 centre = Vec3::Zero();
-    const int k = model_.mesh.nodes_per_element();
     for (int a = 0; a < 4 && e >= 0; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
     std::ostringstream os;
     os << "step " << step_ << ", t = " << time_ << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
@@ -101,7 +100,6 @@ void Simulation::compute_forces() {
        << (std::isnan(last_elements_.min_jacobian) ? "has NaN coordinates" : "is inverted") << " (det F = "
        << last_elements_.min_jacobian << ") near (" << centre.x() << ", " << centre.y() << ", " << centre.z()
        << "); try a smaller time.safety or a finer mesh";
-    (void)k;
     throw Error(os.str());
   }
   const Vec3 g = model_.scene.gravity;

@@ -111,7 +111,7 @@ TEST(Simulation, FreeSpinningBodyConservesMomentaAndEnergy) {
 // motion) and one end driven at v0 carries a front at the dilatational speed
 // c = sqrt((lambda + 2 mu) / rho) with stress rho c v0 behind it.
 TEST(Simulation, DilatationalWaveSpeedAndStress) {
-  const double v0 = 5.0, len = 0.1, w = 0.006;
+  const double v0 = 5.0, len = 0.1;
   const std::string lateral =
       "boundary_conditions:\n"
       "  - {body: b, region: {box: [[-1, -1, -1], [1.0e-9, 1, 1]]}, velocity: [5.0, 0, 0]}\n"
@@ -122,7 +122,6 @@ TEST(Simulation, DilatationalWaveSpeedAndStress) {
   Model m = build_model(scene_from_text(
       "wave", body_scene("wave", "shape: box, size: [0.1, 0.006, 0.006], center: [0.05, 0, 0], element_size: 0.0015",
                          1, "", lateral)));
-  (void)w;
   const NeoHookean& mat = m.materials[0];
   const double c = mat.wave_speed();
   Simulation sim(m, {});
