@@ -121,13 +121,6 @@ int main(int argc, char** argv) {
       MPI_Finalize();
       return status;
     }
-    // The volume decomposition (mesh/partition, runtime/halo) is not yet wired
-    // into the time loop: R ranks would each run the whole model and write
-    // the same files.
-    if (ranks > 1 && *run)
-      throw InputError("run on " + std::to_string(ranks) +
-                       " MPI ranks: the domain decomposition is not wired into the time loop yet; run on 1 rank "
-                       "with --threads T");
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     const Scene scene = load_scene(scene_path, overrides);
     Model model = build_model(scene);

@@ -10,34 +10,6 @@
 namespace shatter {
 namespace {
 
-/// CSR of the sorted, distinct parts of the elements around each node
-/// (the ranks touching it): ranks of node n are ranks[offsets[n] .. offsets[n+1]).
-struct NodeRanks {
-  std::vector<Index> offsets;
-  std::vector<int> ranks;
-
-  std::span<const int> of(Index n) const {
-    return {ranks.data() + offsets[n], static_cast<size_t>(offsets[n + 1] - offsets[n])};
-  }
-};
-
-NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part) {
-  NodeRanks t;
-  const Index nn = mesh.num_nodes();
-  t.offsets.assign(static_cast<size_t>(nn) + 1, 0);
-  std::vector<int> star;
-  for (Index n = 0; n < nn; ++n) {
-    star.clear();
-    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
-      star.push_back(elem_part[mesh.node_elem[p]]);
-    std::sort(star.begin(), star.end());
-    star.erase(std::unique(star.begin(), star.end()), star.end());
-    t.ranks.insert(t.ranks.end(), star.begin(), star.end());
-    t.offsets[n + 1] = static_cast<Index>(t.ranks.size());
-  }
-  return t;
-}
-
 /// Flatten (rank, local node) pairs, each rank's nodes already ascending,
 /// into a NodeExchange.
 NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank) {
@@ -63,6 +35,68 @@ std::vector<Index> order_by_gid(const std::vector<Index>& items, const std::vect
 }
 
 }  // namespace
+
+NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part) {
+  NodeRanks t;
+  const Index nn = mesh.num_nodes();
+  t.offsets.assign(static_cast<size_t>(nn) + 1, 0);
+  std::vector<int> star;
+  for (Index n = 0; n < nn; ++n) {
+    star.clear();
+    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
+      star.push_back(elem_part[mesh.node_elem[p]]);
+    std::sort(star.begin(), star.end());
+    star.erase(std::unique(star.begin(), star.end()), star.end());
+    t.ranks.insert(t.ranks.end(), star.begin(), star.end());
+    t.offsets[n + 1] = static_cast<Index>(t.ranks.size());
+  }
+  return t;
+}
+
+
+std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed) {
+  const Index ne = mesh.num_elements(), ng = (ne + granule - 1) / granule;
+  SHATTER_REQUIRE(parts >= 1 && parts <= ng, "partition_granules: cannot cut " << ng << " granules into " << parts
+                                                                                << " parts");
+  if (parts == 1) return std::vector<int>(ng, 0);
+  // Edges: granule pairs sharing a node, weighted by the number of shared nodes.
+  std::vector<std::pair<idx_t, idx_t>> pairs;
+  std::vector<idx_t> star;
+  for (Index n = 0; n < mesh.num_nodes(); ++n) {
+    star.clear();
+    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
+      star.push_back(mesh.node_elem[p] / granule);
+    std::sort(star.begin(), star.end());
+    star.erase(std::unique(star.begin(), star.end()), star.end());
+    for (size_t i = 0; i < star.size(); ++i)
+      for (size_t j = 0; j < star.size(); ++j)
+        if (i != j) pairs.push_back({star[i], star[j]});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<idx_t> xadj(ng + 1, 0), adjncy, adjwgt, vwgt(ng);
+  for (size_t p = 0; p < pairs.size();) {
+    size_t q = p;
+    while (q < pairs.size() && pairs[q] == pairs[p]) ++q;
+    ++xadj[pairs[p].first + 1];
+    adjncy.push_back(pairs[p].second);
+    adjwgt.push_back(static_cast<idx_t>(q - p));
+    p = q;
+  }
+  for (Index g = 0; g < ng; ++g) {
+    xadj[g + 1] += xadj[g];
+    vwgt[g] = std::min(ne, (g + 1) * granule) - g * granule;
+  }
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_SEED] = seed;
+  options[METIS_OPTION_NUMBERING] = 0;
+  idx_t nv = ng, ncon = 1, nparts = parts, edgecut = 0;
+  std::vector<idx_t> part(ng);
+  const int status = METIS_PartGraphKway(&nv, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr,
+                                         adjwgt.data(), &nparts, nullptr, nullptr, options, &edgecut, part.data());
+  SHATTER_REQUIRE(status == METIS_OK, "partition_granules: METIS_PartGraphKway failed with status " << status);
+  return std::vector<int>(part.begin(), part.end());
+}
 
 std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed) {
   const Index ne = mesh.num_elements();

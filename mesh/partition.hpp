@@ -21,6 +21,29 @@ namespace shatter {
 /// Throws Error when parts < 1, parts > elements, or METIS fails.
 std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed = 1);
 
+/// Part of every granule of `granule` consecutive elements (granule g =
+/// elements [g granule, (g+1) granule)): METIS_PartGraphKway on the granule
+/// graph, two granules adjacent when they share nodes, edge weight = number
+/// of shared nodes, vertex weight = elements; seeded like partition_elements,
+/// so every rank computing it gets the same answer. Needs the node -> element
+/// CSR. For parts = 1 all zeros. Throws Error when parts < 1 or parts > granules.
+std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed = 1);
+
+/// CSR of the sorted, distinct parts of the elements around each node
+/// (the ranks touching it): ranks of node n are ranks[offsets[n] .. offsets[n+1]).
+struct NodeRanks {
+  std::vector<Index> offsets;
+  std::vector<int> ranks;
+
+  std::span<const int> of(Index n) const {
+    return {ranks.data() + offsets[n], static_cast<size_t>(offsets[n + 1] - offsets[n])};
+  }
+};
+
+/// The ranks touching each node (owning an element that uses it), from the
+/// mesh's node -> element CSR and the part of every element.
+NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part);
+
 /// Nodes exchanged with other ranks, grouped by rank: the nodes for ranks[i]
 /// are nodes[offsets[i] .. offsets[i+1]) (local node ids, ascending global
 /// id). ranks is ascending and holds only ranks with at least one node.

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "kernels/tet10.hpp"
+#include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 
 namespace shatter {
@@ -32,10 +33,26 @@ void ElementForces::rebuild() {
     offsets[b + 1] = static_cast<Index>(nodes.size());
   }
   coloring_ = greedy_coloring(offsets, nodes, mesh.num_nodes());
-  block_energy_.assign(nblocks, 0.0);
+  granule_energy_.assign((ne + kGranule - 1) / kGranule, 0.0);
   block_dt_.assign(nblocks, HUGE_VAL);
   block_min_J_.assign(nblocks, HUGE_VAL);
   block_worst_.assign(nblocks, -1);
+  // Every element, block by block, until restrict_to().
+  subset_.resize(ne);
+  for (Index e = 0; e < ne; ++e) subset_[e] = e;
+  subset_offsets_.resize(nblocks + 1);
+  for (Index b = 0; b <= nblocks; ++b) subset_offsets_[b] = std::min(ne, b * kBlock);
+  zero_nodes_.clear();
+}
+
+void ElementForces::restrict_to(std::span<const Index> elements, std::span<const Index> nodes) {
+  const Index nblocks = static_cast<Index>(block_dt_.size());
+  SHATTER_REQUIRE(!nodes.empty() || elements.empty(), "ElementForces::restrict_to: elements without nodes");
+  subset_.assign(elements.begin(), elements.end());
+  zero_nodes_.assign(nodes.begin(), nodes.end());
+  subset_offsets_.assign(nblocks + 1, 0);
+  for (Index e : subset_) ++subset_offsets_[e / kBlock + 1];
+  for (Index b = 0; b < nblocks; ++b) subset_offsets_[b + 1] += subset_offsets_[b];
 }
 
 ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int,
@@ -46,78 +63,89 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
   const int* mat = mesh.elem_material.data();
   const NeoHookean* mats = model_.materials.data();
 
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, f_int.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) f_int[i].setZero();
+  const bool restricted = !zero_nodes_.empty();
+  const size_t nzero = restricted ? zero_nodes_.size() : f_int.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nzero, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) f_int[restricted ? zero_nodes_[i] : i].setZero();
   });
 
   // TET4: four consecutive elements of one material go through the lane
   // kernel together (vectorised across elements); the rest one at a time
   // through the same code with one lane, so the forces are the same bits.
-  auto tet4_group = [&]<int N>(Index e0, const NeoHookean& m, double& energy, double& dt2, double& minJ,
+  auto tet4_group = [&]<int N>(const Index* es, const NeoHookean& m, double& energy, double& dt2, double& minJ,
                                Index& worst) {
     Tet4Lanes<N> L;
     for (int l = 0; l < N; ++l) {
-      const Index* c = conn + 4 * static_cast<size_t>(e0 + l);
+      const Index* c = conn + 4 * static_cast<size_t>(es[l]);
       for (int a = 0; a < 4; ++a)
         for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = x[c[a]][i];
-      const double* D = model_.tet4_Dm_inv[e0 + l].data();
+      const double* D = model_.tet4_Dm_inv[es[l]].data();
       for (int q = 0; q < 9; ++q) L.Dm_inv[q][l] = D[q];
-      L.V0[l] = model_.element_volume[e0 + l];
+      L.V0[l] = model_.element_volume[es[l]];
     }
     tet4_neo_hookean_lanes(L, m);
     double lane_dt2[N];
     tet4_stable_dt_squared_lanes(L, m, lane_dt2);
     for (int l = 0; l < N; ++l) {
-      const Index* c = conn + 4 * static_cast<size_t>(e0 + l);
+      const Index* c = conn + 4 * static_cast<size_t>(es[l]);
       for (int a = 0; a < 4; ++a) f_int[c[a]] += Vec3(L.f[3 * a][l], L.f[3 * a + 1][l], L.f[3 * a + 2][l]);
       energy += L.energy[l];
       dt2 = std::min(dt2, lane_dt2[l]);
       if (worse(L.J[l], minJ)) {
         minJ = L.J[l];
-        worst = e0 + l;
+        worst = es[l];
       }
     }
   };
 
   auto run_block = [&](Index b) {
-    double energy = 0, dt = HUGE_VAL, dt2 = HUGE_VAL, minJ = HUGE_VAL;
+    const Index* first = subset_.data() + subset_offsets_[b];
+    const Index* last = subset_.data() + subset_offsets_[b + 1];
+    double dt = HUGE_VAL, dt2 = HUGE_VAL, minJ = HUGE_VAL;
     Index worst = -1;
-    const Index end = std::min(ne, (b + 1) * kBlock);
-    if (mesh.order == 1) {
-      Index e = b * kBlock;
-      while (e < end) {
-        const int m = mat[e];
-        if (e + 4 <= end && mat[e + 1] == m && mat[e + 2] == m && mat[e + 3] == m) {
-          tet4_group.template operator()<4>(e, mats[m], energy, dt2, minJ, worst);
-          e += 4;
-        } else {
-          tet4_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
-          e += 1;
+    // One granule at a time: its energy is summed on its own.
+    for (const Index* g0 = first; g0 < last;) {
+      const Index granule = *g0 / kGranule;
+      const Index* g1 = g0;
+      while (g1 < last && *g1 / kGranule == granule) ++g1;
+      double energy = 0;
+      if (mesh.order == 1) {
+        for (const Index* e = g0; e < g1;) {
+          const int m = mat[*e];
+          if (g1 - e >= 4 && mat[e[1]] == m && mat[e[2]] == m && mat[e[3]] == m) {
+            tet4_group.template operator()<4>(e, mats[m], energy, dt2, minJ, worst);
+            e += 4;
+          } else {
+            tet4_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
+            e += 1;
+          }
+        }
+      } else {
+        for (const Index* p = g0; p < g1; ++p) {
+          const Index e = *p;
+          const NeoHookean& m = mats[mat[e]];
+          const Index* c = conn + 10 * static_cast<size_t>(e);
+          Tet10Nodes xe;
+          for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
+          const Tet10Force out = tet10_internal_force(xe, model_.tet10_ref[e], m);
+          for (int a = 0; a < 10; ++a) f_int[c[a]] += out.f.col(a);
+          energy += out.energy;
+          const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
+          // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
+          dt = std::min(dt, h / m.wave_speed(out.J > 0 ? out.J : 1.0));
+          if (worse(out.J, minJ)) {
+            minJ = out.J;
+            worst = e;
+          }
         }
       }
-      dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt
-    } else {
-      for (Index e = b * kBlock; e < end; ++e) {
-        const NeoHookean& m = mats[mat[e]];
-        const Index* c = conn + 10 * static_cast<size_t>(e);
-        Tet10Nodes xe;
-        for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
-        const Tet10Force out = tet10_internal_force(xe, model_.tet10_ref[e], m);
-        for (int a = 0; a < 10; ++a) f_int[c[a]] += out.f.col(a);
-        energy += out.energy;
-        const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
-        // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
-        dt = std::min(dt, h / m.wave_speed(out.J > 0 ? out.J : 1.0));
-        if (worse(out.J, minJ)) {
-          minJ = out.J;
-          worst = e;
-        }
-      }
+      granule_energy_[granule] = energy;
+      g0 = g1;
     }
+    if (mesh.order == 1) dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt
     if (!stress6.empty())
-      for (Index e = b * kBlock; e < end; ++e)
-        element_cauchy_stress6(model_, x, e, stress6.data() + 6 * static_cast<size_t>(e));
-    block_energy_[b] = energy;
+      for (const Index* e = first; e < last; ++e)
+        element_cauchy_stress6(model_, x, *e, stress6.data() + 6 * static_cast<size_t>(*e));
     block_dt_[b] = dt;
     block_min_J_[b] = minJ;
     block_worst_[b] = worst;
@@ -131,8 +159,8 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
   }
 
   ElementLoopResult res;
-  for (size_t b = 0; b < block_energy_.size(); ++b) {
-    res.strain_energy += block_energy_[b];
+  for (double e : granule_energy_) res.strain_energy += e;
+  for (size_t b = 0; b < block_dt_.size(); ++b) {
     res.stable_dt = std::min(res.stable_dt, block_dt_[b]);
     if (worse(block_min_J_[b], res.min_jacobian)) {
       res.min_jacobian = block_min_J_[b];

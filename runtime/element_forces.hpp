@@ -5,6 +5,14 @@
 // forces straight into the nodal array. A node receives its contributions in
 // a fixed order (color, block, element), so forces are bitwise identical for
 // any thread count.
+//
+// Under MPI (runtime/decomposition.hpp) a rank computes only a subset of the
+// elements (its owned granules and its ghost layer) with the SAME blocks and
+// colors: a node whose whole element star is in the subset receives the same
+// contributions in the same order as in a serial run, i.e. the same bits. The
+// strain energy is summed per granule of kGranule consecutive elements, the
+// unit of ownership between ranks, so that sums over granules combined in
+// granule order do not depend on the decomposition.
 #include <span>
 #include <vector>
 
@@ -27,13 +35,26 @@ class ElementForces {
   /// 300k elements (docs/performance.md, "Element kernels": 1024 and 4096
   /// equal within noise, 256 is 15 % slower).
   static constexpr Index kBlock = 1024;
+  /// Elements per granule (a block holds kBlock / kGranule of them).
+  static constexpr Index kGranule = 256;
+  static_assert(kBlock % kGranule == 0 && kGranule % 4 == 0);
 
   explicit ElementForces(const Model& model);
 
   /// Recolor after a topology change (node splitting).
   void rebuild();
 
-  /// f_int = dE/dx at positions x (overwrites f_int, size = nodes). When
+  /// Compute only `elements` (ascending) from now on, and zero only `nodes`
+  /// (ascending: the nodes of those elements) in f_int. Blocks without one
+  /// of them are skipped. Without a call: every element and node.
+  void restrict_to(std::span<const Index> elements, std::span<const Index> nodes);
+
+  /// Strain energy of each granule's computed elements in the last compute(), J.
+  std::span<const double> granule_energy() const { return granule_energy_; }
+
+  /// f_int = dE/dx at positions x (overwrites f_int, size = nodes). The
+  /// result's strain_energy is the sum of granule_energy() in granule order,
+  /// stable_dt and min_jacobian are over the computed elements. When
   /// stress6 is not empty, also writes each element's Cauchy stress there
   /// (6 per element, as element_cauchy_stress6) for the fracture check.
   ElementLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int, std::span<double> stress6 = {}) const;
@@ -43,7 +64,9 @@ class ElementForces {
  private:
   const Model& model_;
   Coloring coloring_;
-  mutable std::vector<double> block_energy_, block_dt_, block_min_J_;
+  std::vector<Index> subset_offsets_, subset_;  ///< CSR per block: its elements to compute
+  std::vector<Index> zero_nodes_;               ///< nodes to zero after restrict_to (empty: all)
+  mutable std::vector<double> granule_energy_, block_dt_, block_min_J_;
   mutable std::vector<Index> block_worst_;
 };
 

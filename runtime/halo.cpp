@@ -42,6 +42,12 @@ Halo::Halo(const LocalMesh& local, MPI_Comm comm)
   combine_offsets_.push_back(static_cast<Index>(combine_source_.size()));
 }
 
+Halo::Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm)
+    : num_nodes_(num_nodes), send_(send), recv_(receive), only_send_(send), only_recv_(receive) {
+  MPI_Comm_dup(comm, &comm_);
+  combine_offsets_.push_back(0);
+}
+
 Halo::~Halo() {
   if (pending_ != Pending::none) wait();
   MPI_Comm_free(&comm_);

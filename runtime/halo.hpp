@@ -52,6 +52,12 @@ class Halo {
   /// caller's). `local` must be the LocalMesh of this rank of `comm`; its node
   /// lists are copied.
   Halo(const LocalMesh& local, MPI_Comm comm);
+  /// A Halo that only refreshes copies: `send` lists, per other rank, the
+  /// nodes of the `num_nodes` whose values go there, `receive` the nodes
+  /// filled from each rank (lists matching pairwise as in LocalMesh).
+  /// update_ghosts refreshes exactly those (for either GhostCopies); there is
+  /// nothing to sum. Collective over `comm`.
+  Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm);
   ~Halo();
   Halo(const Halo&) = delete;
   Halo& operator=(const Halo&) = delete;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <cstdio>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/contact_stage.hpp"
+#include "runtime/decomposition.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/parallel.hpp"
@@ -36,8 +38,17 @@ struct BodyRow {
 }  // namespace
 
 Simulation::Simulation(Model& model, RunOptions options)
-    : model_(model), opt_(std::move(options)), elements_(model) {
+    : model_(model),
+      opt_(std::move(options)),
+      dec_(std::make_unique<Decomposition>(model, opt_.ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF)),
+      elements_(model) {
   const Mesh& mesh = model_.mesh;
+  if (dec_->distributed()) {
+    if (model_.scene.fracture_enabled())
+      throw InputError(model_.scene.file + ": materials with a fracture block run on one MPI rank only (for now); "
+                       "run with mpirun -np 1 and --threads T");
+    elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
+  }
   const Index n = mesh.num_nodes();
   x_ = mesh.reference;
   v_ = model_.initial_velocity;
@@ -52,6 +63,12 @@ Simulation::Simulation(Model& model, RunOptions options)
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
   if (model_.scene.contact) {
     contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
+    if (dec_->distributed()) {
+      const std::vector<Index>& v = contact_->surface().vertices;
+      std::vector<Index> vertices(v.begin(), v.end());
+      std::sort(vertices.begin(), vertices.end());
+      surface_nodes_ = std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(vertices)));
+    }
     // DCR treats a node with any prescribed component as immovable.
     contact_inv_mass_.resize(n);
     for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
@@ -61,12 +78,13 @@ Simulation::Simulation(Model& model, RunOptions options)
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
   }
   ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
+  granule_sums_.assign(static_cast<size_t>(dec_->num_granules()) * kGranuleSums, 0.0);
   compute_forces();
   update_ledger();
   total0_ = ledger_.total();
   stable_dt0_ = stable_dt_;
   energy_scale_ = std::max(ledger_.kinetic + ledger_.strain, 1e-300);
-  if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && !opt_.quiet)
+  if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && !opt_.quiet && dec_->rank() == 0)
     std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
                  model_.scene.file.c_str(), *model_.scene.fixed_dt, stable_dt_);
 }
@@ -89,11 +107,26 @@ void Simulation::compute_forces() {
     ledger_.cohesive_stored = ce.stored;
     ledger_.cohesive_dissipated = ce.dissipated;
   }
-  stable_dt_ = last_elements_.stable_dt;
+  stable_dt_ = dec_->min(last_elements_.stable_dt);
+  if (dec_->distributed()) {
+    // The worst element over all ranks (NaN first, then the smallest det F,
+    // then the smallest index, as on one rank).
+    struct {
+      double J;
+      int e;
+    } worst{std::isnan(last_elements_.min_jacobian) ? -HUGE_VAL : last_elements_.min_jacobian,
+            last_elements_.worst_element < 0 ? std::numeric_limits<int>::max() : last_elements_.worst_element};
+    MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE_INT, MPI_MINLOC, dec_->comm());
+    last_elements_.min_jacobian = worst.J == -HUGE_VAL ? std::nan("") : worst.J;
+    last_elements_.worst_element = worst.e == std::numeric_limits<int>::max() ? -1 : worst.e;
+  }
   if (!(last_elements_.min_jacobian > 0)) {
     const Index e = last_elements_.worst_element;
     Vec3 centre = Vec3::Zero();
-    for (int a = 0; a < 4 && e >= 0; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
+    // The element's owner has its current positions.
+    if (e >= 0 && dec_->owns_granule(e / ElementForces::kGranule))
+      for (int a = 0; a < 4; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
+    dec_->combine_granules({centre.data(), 3});
     std::ostringstream os;
     os << "step " << step_ << ", t = " << time_ << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
        << " (body '" << (e >= 0 ? model_.scene.bodies[model_.mesh.elem_body[e]].name : "?") << "') "
@@ -104,7 +137,7 @@ void Simulation::compute_forces() {
   }
   const Vec3 g = model_.scene.gravity;
   const Index n = model_.mesh.num_nodes();
-  parallel_for_each(n, [&](Index i) {
+  dec_->for_touched(n, [&](Index i) {
     f_ext_[i] = model_.mass[i] * g;
     a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
   });
@@ -131,44 +164,52 @@ void Simulation::step() {
   std::vector<Vec3> dx_bc(bc_nodes_.size());
   const std::vector<Vec3> reaction_old = reaction_;
 
-  parallel_for_each(n, [&](Index i) {
+  auto half_kick = [&](Index i) {
     v_[i] += half * a_[i];
     if (model_.bc_mask[i])
       for (int c = 0; c < 3; ++c)
         if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
-  });
+  };
+  dec_->for_touched(n, half_kick);
   for (size_t b = 0; b < bc_nodes_.size(); ++b) dx_bc[b] = dt * v_[bc_nodes_[b]];
+  if (contact_) x_prev_ = x_;
+  dec_->for_touched(n, [&](Index i) { x_[i] += dt * v_[i]; });
   if (contact_) {
-    x_prev_ = x_;
-    parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
+    // Every rank resolves the whole contact surface from the owners' states.
+    if (surface_nodes_) {
+      const std::span<Vec3> arrays[] = {x_prev_, x_, v_};
+      dec_->share(*surface_nodes_, arrays);
+    }
     const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_);
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
-      if (ledger_.contact_capped_steps == 0 && !opt_.quiet)
+      if (ledger_.contact_capped_steps == 0 && !opt_.quiet && dec_->rank() == 0)
         std::fprintf(stderr, "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
                      "counted in history.csv column contact_capped_steps\n", step_ + 1, r.sweeps);
       ++ledger_.contact_capped_steps;
     }
-  } else {
-    parallel_for_each(n, [&](Index i) { x_[i] += dt * v_[i]; });
   }
-  // Gravity's work over the step's displacement (the projection's included).
-  const double gravity_work = g.squaredNorm() == 0 ? 0.0 : deterministic_sum(n, 0.0, [&](Index i) {
-    return model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
-  });
+  dec_->update_ghost_only(x_);
+  // Gravity's work over the step's displacement (the projection's included),
+  // per home granule.
+  for (Index gr : dec_->owned_granules()) {
+    double w = 0;
+    if (g.squaredNorm() != 0)
+      for (Index i : dec_->home_nodes(gr))
+        w += model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
+    granule_sums_[gr * kGranuleSums + 8] = w;
+    granule_sums_[gr * kGranuleSums + 9] = 0;
+  }
 
   compute_forces();
 
-  parallel_for_each(n, [&](Index i) {
-    v_[i] += half * a_[i];
-    if (model_.bc_mask[i])
-      for (int c = 0; c < 3; ++c)
-        if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
-  });
-  double reaction_work = 0;
-  for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction_work += 0.5 * (reaction_old[b] + reaction_[b]).dot(dx_bc[b]);
-  ledger_.external_work += gravity_work + reaction_work;
+  dec_->for_touched(n, half_kick);
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) {
+    const Index gr = dec_->home_granule(bc_nodes_[b]);
+    if (dec_->owns_granule(gr))
+      granule_sums_[gr * kGranuleSums + 9] += 0.5 * (reaction_old[b] + reaction_[b]).dot(dx_bc[b]);
+  }
   time_ += dt;
   ++step_;
   if (fracture_) apply_fracture();
@@ -216,6 +257,7 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
     inv_mass_[i] = 1.0 / model_.mass[i];
     if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
+  dec_->rebuild_nodes();
 }
 
 void Simulation::save_state(SimulationState& s) const {
@@ -255,25 +297,43 @@ void Simulation::restore_state(const SimulationState& s) {
   ledger_ = s.ledger;
   total0_ = s.total0;
   energy_scale_ = s.energy_scale;
-  last_elements_.strain_energy = s.ledger.strain;
   last_elements_.stable_dt = s.stable_dt;
   restored_ = true;
 }
 
 void Simulation::update_ledger() {
-  const Index n = model_.mesh.num_nodes();
-  const Momenta m = deterministic_sum(n, Momenta{}, [&](Index i) {
-    Momenta t;
-    const Vec3 p = model_.mass[i] * v_[i];
-    t.kinetic = 0.5 * p.dot(v_[i]);
-    t.p = p;
-    t.L = x_[i].cross(p);
-    return t;
+  // Per granule, on its owner: sums over its home nodes in ascending order
+  // and its elements' strain energy; then the granules in order (the same
+  // bits for any decomposition and thread count).
+  const auto owned = dec_->owned_granules();
+  const std::span<const double> strain = elements_.granule_energy();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, owned.size()), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const Index gr = owned[k];
+      Momenta m;
+      for (Index i : dec_->home_nodes(gr)) {
+        const Vec3 p = model_.mass[i] * v_[i];
+        m.kinetic += 0.5 * p.dot(v_[i]);
+        m.p += p;
+        m.L += x_[i].cross(p);
+      }
+      double* s = granule_sums_.data() + gr * kGranuleSums;
+      s[0] = m.kinetic;
+      for (int c = 0; c < 3; ++c) s[1 + c] = m.p[c], s[4 + c] = m.L[c];
+      s[7] = strain[gr];
+    }
   });
-  ledger_.kinetic = m.kinetic;
-  ledger_.momentum = m.p;
-  ledger_.angular_momentum = m.L;
-  ledger_.strain = last_elements_.strain_energy;
+  std::vector<double> all = granule_sums_;
+  dec_->combine_granules(all);
+  double t[kGranuleSums] = {};
+  for (Index gr = 0; gr < dec_->num_granules(); ++gr)
+    for (int f = 0; f < kGranuleSums; ++f) t[f] += all[gr * kGranuleSums + f];
+  for (Index gr : owned) granule_sums_[gr * kGranuleSums + 8] = granule_sums_[gr * kGranuleSums + 9] = 0;
+  ledger_.kinetic = t[0];
+  ledger_.momentum = Vec3(t[1], t[2], t[3]);
+  ledger_.angular_momentum = Vec3(t[4], t[5], t[6]);
+  ledger_.strain = t[7];
+  ledger_.external_work += t[8] + t[9];
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
                                               std::abs(ledger_.external_work));
@@ -286,23 +346,38 @@ void Simulation::write_outputs(bool fields) {
     frags = fracture_->fragments(x_, v_, model_.mass);
     ledger_.fragments = frags->count();
   }
+  const bool root = dec_->rank() == 0;
   const Ledger& l = ledger_;
-  *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
-            << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
-            << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
-            << l.contacts << l.cohesive_elements << l.fragments << l.contact_capped_steps;
-  history_->end_row();
+  if (root) {
+    *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
+              << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
+              << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
+              << l.contacts << l.cohesive_elements << l.fragments << l.contact_capped_steps;
+    history_->end_row();
+  }
 
+  // Body rows: mass, m x, m v per (home granule, body), granules in order.
   const Mesh& mesh = model_.mesh;
   const int nb = static_cast<int>(model_.scene.bodies.size());
+  const Index ng = dec_->num_granules();
+  std::vector<double> sums(static_cast<size_t>(ng) * nb * 7, 0.0);
+  for (Index gr : dec_->owned_granules())
+    for (Index i : dec_->home_nodes(gr)) {
+      double* r = sums.data() + (static_cast<size_t>(gr) * nb + mesh.node_body[i]) * 7;
+      const double m = model_.mass[i];
+      r[0] += m;
+      for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
+    }
+  dec_->combine_granules(sums);
   std::vector<BodyRow> rows(nb);
-  for (Index i = 0; i < mesh.num_nodes(); ++i) {
-    BodyRow& r = rows[mesh.node_body[i]];
-    r.mass += model_.mass[i];
-    r.mx += model_.mass[i] * x_[i];
-    r.mv += model_.mass[i] * v_[i];
-  }
-  for (int b = 0; b < nb; ++b) {
+  for (Index gr = 0; gr < ng; ++gr)
+    for (int b = 0; b < nb; ++b) {
+      const double* r = sums.data() + (static_cast<size_t>(gr) * nb + b) * 7;
+      rows[b].mass += r[0];
+      rows[b].mx += Vec3(r[1], r[2], r[3]);
+      rows[b].mv += Vec3(r[4], r[5], r[6]);
+    }
+  for (int b = 0; b < nb && root; ++b) {
     const Vec3 c = rows[b].mx / rows[b].mass, v = rows[b].mv / rows[b].mass;
     *bodies_ << step_ << time_ << model_.scene.bodies[b].name << rows[b].mass << c.x() << c.y() << c.z() << v.x()
              << v.y() << v.z();
@@ -310,30 +385,43 @@ void Simulation::write_outputs(bool fields) {
   }
 
   if (fields && fields_) {
-    std::vector<Vec3> u(mesh.num_nodes());
-    for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] = x_[i] - mesh.reference[i];
+    // Rank 0 writes every row (from the owners' values); the others take
+    // part in the collective writes with none.
+    std::vector<Vec3> u, vel;
     std::vector<double> stress, vm;
-    element_stresses(model_, x_, stress, vm);
     FieldFrame f;
     f.step = static_cast<int>(step_);
     f.time = time_;
-    f.displacement = u;
-    f.velocity = v_;
-    f.stress = stress;
-    f.von_mises = vm;
-    f.body = mesh.elem_body;
-    std::vector<int> fragment_id;
-    if (frags) {
-      fragment_id.assign(frags->elem_fragment.begin(), frags->elem_fragment.end());
-      f.fragment = fragment_id;
+    Mesh empty;
+    empty.order = mesh.order;
+    u = x_;
+    vel = v_;
+    if (dec_->distributed()) {
+      const std::span<Vec3> arrays[] = {u, vel};
+      dec_->gather_to_root(arrays);
     }
-    fields_->write(mesh, f);
+    std::vector<int> fragment_id;
+    if (root) {
+      element_stresses(model_, u, stress, vm);
+      for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] -= mesh.reference[i];
+      f.displacement = u;
+      f.velocity = vel;
+      f.stress = stress;
+      f.von_mises = vm;
+      f.body = mesh.elem_body;
+      if (frags) {
+        fragment_id.assign(frags->elem_fragment.begin(), frags->elem_fragment.end());
+        f.fragment = fragment_id;
+      }
+    }
+    fields_->write(root ? mesh : empty, f);
   }
 }
 
 long Simulation::run() {
   const Scene& scene = model_.scene;
   const auto wall0 = std::chrono::steady_clock::now();
+  const bool root = dec_->rank() == 0;
   long field_every = scene.output_every;
   if (field_every < 0) {
     // Default: about 20 frames over the run.
@@ -345,8 +433,9 @@ long Simulation::run() {
     std::filesystem::create_directories(opt_.out_dir, ec);
     if (ec) throw Error("cannot create the output folder " + opt_.out_dir.string() + ": " + ec.message());
     // A restart keeps the rows up to its step and appends the rest.
-    if (restored_)
+    if (restored_ && root)
       for (const char* csv : {"history.csv", "bodies.csv"}) truncate_rows_after(opt_.out_dir / csv, step_);
+    if (root) {
     history_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "history.csv",
         std::vector<std::string>{"step", "time", "dt", "kinetic", "strain", "cohesive_stored", "cohesive_dissipated",
@@ -356,17 +445,23 @@ long Simulation::run() {
     bodies_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "bodies.csv",
         std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"}, restored_);
+    }
     // A restart's frames go to OUTDIR/restart_<step>/; fields.h5 keeps the earlier ones.
     const std::filesystem::path field_dir =
         restored_ ? opt_.out_dir / ("restart_" + std::to_string(step_)) : opt_.out_dir;
-    if (field_every > 0) fields_ = std::make_unique<FieldWriter>(field_dir, MPI_COMM_WORLD);
+    if (field_every > 0)
+      fields_ = std::make_unique<FieldWriter>(field_dir, dec_->distributed() ? dec_->comm() : MPI_COMM_WORLD);
   }
-  Progress progress(scene.end_time, opt_.quiet);
+  Progress progress(scene.end_time, opt_.quiet || !root);
   if (!restored_) write_outputs(field_every > 0);
   // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
-  // last good state when a step fails; not for scenes with fracture.
+  // last good state when a step fails; not for scenes with fracture, nor on
+  // several ranks (yet).
   const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
-  const bool checkpoints = !opt_.out_dir.empty() && !fracture_;
+  const bool checkpoints = !opt_.out_dir.empty() && !fracture_ && !dec_->distributed();
+  if (dec_->distributed() && scene.checkpoint && root && !opt_.quiet)
+    std::fprintf(stderr, "warning: %s: checkpoints are written on one MPI rank only (for now); this run on %d "
+                 "ranks writes none\n", scene.file.c_str(), dec_->size());
   SimulationState good;  // the state before the current step
   auto last_checkpoint = std::chrono::steady_clock::now();
   const double tiny = 1e-12 * scene.end_time;
@@ -390,7 +485,7 @@ long Simulation::run() {
     const bool field_row = field_every > 0 && (step_ % field_every == 0 || last);
     if (step_ % scene.history_every == 0 || last || field_row) write_outputs(field_row);
     progress.update(step_, time_, dt_, energy_error(), last);
-    const int stop = last ? 0 : stop_signal();
+    const int stop = last ? 0 : dec_->max(stop_signal());
     const auto now = std::chrono::steady_clock::now();
     const std::optional<CheckpointSpec>& every = scene.checkpoint;
     const bool due = every && ((every->every_steps > 0 && step_ % every->every_steps == 0) ||
@@ -405,14 +500,15 @@ long Simulation::run() {
       progress.finish();
       const std::string where = checkpoints ? "; continue with --restart " + checkpoint.string()
                                 : fracture_ ? "; no checkpoint written (a scene with fracture cannot be restarted yet)"
-                                            : "; no checkpoint written (no output folder)";
+                                : dec_->distributed() ? "; no checkpoint written (runs on several ranks write none yet)"
+                                                      : "; no checkpoint written (no output folder)";
       throw Error("stopped by signal " + std::to_string(stop) + " after step " + std::to_string(step_) + where);
     }
   }
   progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   fields_.reset();
-  if (!opt_.out_dir.empty()) {
+  if (!opt_.out_dir.empty() && root) {
     if (fracture_) write_fragments();
     write_summary(wall);
   }
@@ -436,7 +532,7 @@ void Simulation::write_summary(double wall) {
   JsonObject j;
   j.add("name", model_.scene.name);
   j.add("scene", model_.scene.file);
-  j.add("ranks", opt_.ranks);
+  j.add("ranks", dec_->size());
   j.add("threads", opt_.threads);
   j.add("deterministic", std::string(opt_.deterministic ? "true" : "false"));
   j.add("steps", step_);
@@ -446,8 +542,11 @@ void Simulation::write_summary(double wall) {
   j.add("element_loop_time", element_seconds_);
   // element-steps per second per core spent in the element loop
   j.add("element_updates_per_second",
-        element_seconds_ > 0 ? double(model_.mesh.num_elements()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
+        element_seconds_ > 0 ? double(dec_->local_elements().size()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
+  j.add("owned_elements_rank0", static_cast<long>(dec_->owned_elements()));
+  j.add("local_elements_rank0", static_cast<long>(dec_->local_elements().size()));
+  j.add("ghost_bytes_per_step_rank0", static_cast<long>(dec_->ghost_bytes()));
   j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
   j.add("elements", static_cast<long>(model_.mesh.num_elements()));
   j.add("element_order", model_.mesh.order);

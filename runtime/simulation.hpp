@@ -25,6 +25,8 @@ class FieldWriter;
 class CsvWriter;
 class ContactStage;
 class FractureStage;
+class Decomposition;
+struct SharedNodes;
 
 struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
@@ -87,6 +89,7 @@ class Simulation {
   double element_loop_seconds() const { return element_seconds_; }
   const ContactStage* contact() const { return contact_.get(); }
   const FractureStage* fracture() const { return fracture_.get(); }
+  const Decomposition& decomposition() const { return *dec_; }
 
   /// Copies the state between two steps into `state` (reusing its storage).
   void save_state(SimulationState& state) const;
@@ -103,9 +106,16 @@ class Simulation {
   void write_summary(double wall_seconds);
   double next_dt() const;
 
+  /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
+  /// strain, the step's gravity work, the step's reaction work.
+  static constexpr int kGranuleSums = 10;
+
   Model& model_;
   RunOptions opt_;
+  std::unique_ptr<Decomposition> dec_;
   ElementForces elements_;
+  std::vector<double> granule_sums_;  ///< [g * kGranuleSums + field], this rank's granules only
+  std::unique_ptr<SharedNodes> surface_nodes_;  ///< contact surface vertices shared by all ranks
   std::vector<Vec3> x_, v_, a_, f_int_, f_ext_;
   std::vector<double> inv_mass_;
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component

@@ -1,0 +1,218 @@
+#include "runtime/decomposition.hpp"
+
+#include <algorithm>
+#include <map>
+#include <string>
+
+#include "kernels/error.hpp"
+#include "mesh/partition.hpp"
+#include "runtime/element_forces.hpp"
+#include "runtime/halo.hpp"
+
+namespace shatter {
+namespace {
+
+NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank) {
+  NodeExchange x;
+  for (const auto& [q, nodes] : by_rank) {
+    x.ranks.push_back(q);
+    x.nodes.insert(x.nodes.end(), nodes.begin(), nodes.end());
+    x.offsets.push_back(static_cast<Index>(x.nodes.size()));
+  }
+  return x;
+}
+
+/// This rank's values of the plan's nodes it owns, interleaved: node-major, then array, then component.
+std::vector<double> pack(const SharedNodes& plan, int rank, std::span<const std::span<Vec3>> arrays) {
+  const size_t m = 3 * arrays.size(), first = plan.displacements[rank];
+  std::vector<double> out(plan.counts[rank] * m);
+  for (size_t i = 0; i < static_cast<size_t>(plan.counts[rank]); ++i)
+    for (size_t a = 0; a < arrays.size(); ++a)
+      for (int c = 0; c < 3; ++c) out[i * m + 3 * a + c] = arrays[a][plan.by_rank[first + i]][c];
+  return out;
+}
+
+void unpack(const SharedNodes& plan, std::span<const double> in, std::span<const std::span<Vec3>> arrays) {
+  const size_t m = 3 * arrays.size();
+  for (size_t i = 0; i < plan.by_rank.size(); ++i)
+    for (size_t a = 0; a < arrays.size(); ++a)
+      for (int c = 0; c < 3; ++c) arrays[a][plan.by_rank[i]][c] = in[i * m + 3 * a + c];
+}
+
+/// Counts and displacements of the plan in doubles, for m doubles per node.
+std::pair<std::vector<int>, std::vector<int>> layout(const SharedNodes& plan, int m) {
+  std::pair<std::vector<int>, std::vector<int>> l{plan.counts, plan.displacements};
+  for (size_t r = 0; r < plan.counts.size(); ++r) l.first[r] *= m, l.second[r] *= m;
+  return l;
+}
+
+}  // namespace
+
+Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) {
+  int initialised = 0;
+  MPI_Initialized(&initialised);
+  if (initialised) {
+    comm_ = comm;
+    MPI_Comm_rank(comm, &rank_);
+    MPI_Comm_size(comm, &size_);
+  }
+  const Mesh& mesh = model.mesh;
+  const Index ng = (mesh.num_elements() + ElementForces::kGranule - 1) / ElementForces::kGranule;
+  if (size_ > ng)
+    throw InputError(model.scene.file + ": the mesh has " + std::to_string(mesh.num_elements()) + " elements, " +
+                     std::to_string(ng) + " granules of " + std::to_string(ElementForces::kGranule) +
+                     "; it cannot be shared by " + std::to_string(size_) + " MPI ranks (use at most " +
+                     std::to_string(ng) + ")");
+  granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
+  std::vector<Index> per_rank(size_, 0);
+  for (Index g = 0; g < ng; ++g) {
+    ++per_rank[granule_rank_[g]];
+    if (granule_rank_[g] == rank_) {
+      owned_granules_.push_back(g);
+      owned_elements_ += std::min(mesh.num_elements(), (g + 1) * ElementForces::kGranule) - g * ElementForces::kGranule;
+    }
+  }
+  for (int r = 0; r < size_; ++r)
+    if (per_rank[r] == 0)
+      throw InputError(model.scene.file + ": METIS left MPI rank " + std::to_string(r) + " of " +
+                       std::to_string(size_) + " without elements; use fewer ranks");
+  rebuild_nodes();
+}
+
+Decomposition::~Decomposition() = default;
+
+void Decomposition::rebuild_nodes() {
+  const Mesh& mesh = model_.mesh;
+  const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
+  const int k = mesh.nodes_per_element();
+  const Index ng = num_granules();
+
+  // Home granule of each node: the granule of the first element of its star.
+  home_granule_.assign(nn, -1);
+  for (Index e = 0; e < ne; ++e)
+    for (int a = 0; a < k; ++a) {
+      Index& h = home_granule_[mesh.element(e)[a]];
+      if (h < 0) h = e / ElementForces::kGranule;
+    }
+  home_offsets_.assign(ng + 1, 0);
+  for (Index n = 0; n < nn; ++n) ++home_offsets_[home_granule_[n] + 1];
+  for (Index g = 0; g < ng; ++g) home_offsets_[g + 1] += home_offsets_[g];
+  home_nodes_.resize(nn);
+  {
+    std::vector<Index> fill(home_offsets_.begin(), home_offsets_.end() - 1);
+    for (Index n = 0; n < nn; ++n) home_nodes_[fill[home_granule_[n]]++] = n;
+  }
+
+  std::vector<int> elem_part(ne);
+  for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[e / ElementForces::kGranule];
+  NodeRanks touch = touching_ranks(mesh, elem_part);
+  node_rank_offsets_ = std::move(touch.offsets);
+  node_ranks_ = std::move(touch.ranks);
+  auto touches = [&](Index n, int r) {
+    return std::binary_search(node_ranks_.begin() + node_rank_offsets_[n],
+                              node_ranks_.begin() + node_rank_offsets_[n + 1], r);
+  };
+
+  touched_nodes_.clear();
+  local_elements_.clear();
+  held_nodes_.clear();
+  std::vector<char> held(nn, 0);
+  for (Index n = 0; n < nn; ++n)
+    if (touches(n, rank_)) touched_nodes_.push_back(n);
+  for (Index e = 0; e < ne; ++e) {
+    bool local = false;
+    for (int a = 0; a < k && !local; ++a) local = touches(mesh.element(e)[a], rank_);
+    if (!local) continue;
+    local_elements_.push_back(e);
+    for (int a = 0; a < k; ++a) held[mesh.element(e)[a]] = 1;
+  }
+  for (Index n = 0; n < nn; ++n)
+    if (held[n]) held_nodes_.push_back(n);
+
+  if (size_ > 1) {
+    // Receive: ghost-only nodes (held, not touched) from their owners.
+    std::map<int, std::vector<Index>> recv, send;
+    for (Index n : held_nodes_)
+      if (!touches(n, rank_)) recv[node_owner(n)].push_back(n);
+    // Send: nodes owned here to every rank holding them without touching
+    // them. Rank q holds n when it touches a node of an element of n's star.
+    std::vector<int> holders;
+    for (Index n : touched_nodes_) {
+      if (node_owner(n) != rank_) continue;
+      holders.clear();
+      for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p) {
+        const Index* c = mesh.element(mesh.node_elem[p]);
+        for (int a = 0; a < k; ++a)
+          for (Index q = node_rank_offsets_[c[a]]; q < node_rank_offsets_[c[a] + 1]; ++q)
+            holders.push_back(node_ranks_[q]);
+      }
+      std::sort(holders.begin(), holders.end());
+      holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
+      for (int q : holders)
+        if (!touches(n, q)) send[q].push_back(n);
+    }
+    halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_);
+    std::vector<Index> all(nn);
+    for (Index n = 0; n < nn; ++n) all[n] = n;
+    all_nodes_ = shared_nodes(std::move(all));
+  }
+}
+
+void Decomposition::update_ghost_only(std::span<Vec3> x) {
+  if (halo_) halo_->update_ghosts(x);
+}
+
+std::size_t Decomposition::ghost_bytes() const { return halo_ ? halo_->update_bytes(3) : 0; }
+
+SharedNodes Decomposition::shared_nodes(std::vector<Index> nodes) const {
+  SharedNodes s;
+  s.nodes = std::move(nodes);
+  s.counts.assign(size_, 0);
+  s.displacements.assign(size_, 0);
+  if (size_ == 1) return s;
+  for (Index n : s.nodes) ++s.counts[node_owner(n)];
+  for (int r = 1; r < size_; ++r) s.displacements[r] = s.displacements[r - 1] + s.counts[r - 1];
+  s.by_rank.resize(s.nodes.size());
+  std::vector<int> fill = s.displacements;
+  for (Index n : s.nodes) s.by_rank[fill[node_owner(n)]++] = n;
+  return s;
+}
+
+void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) {
+  if (size_ == 1) return;
+  const int m = 3 * static_cast<int>(arrays.size());
+  const std::vector<double> out = pack(plan, rank_, arrays);
+  std::vector<double> in(plan.by_rank.size() * m);
+  const auto [counts, displs] = layout(plan, m);
+  MPI_Allgatherv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, in.data(), counts.data(), displs.data(),
+                 MPI_DOUBLE, comm_);
+  unpack(plan, in, arrays);
+}
+
+void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) {
+  if (size_ == 1) return;
+  const int m = 3 * static_cast<int>(arrays.size());
+  const std::vector<double> out = pack(all_nodes_, rank_, arrays);
+  std::vector<double> in(rank_ == 0 ? all_nodes_.by_rank.size() * m : 0);
+  const auto [counts, displs] = layout(all_nodes_, m);
+  MPI_Gatherv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, in.data(), counts.data(), displs.data(),
+              MPI_DOUBLE, 0, comm_);
+  if (rank_ == 0) unpack(all_nodes_, in, arrays);
+}
+
+void Decomposition::combine_granules(std::span<double> values) {
+  if (size_ > 1)
+    MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
+}
+
+double Decomposition::min(double value) const {
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  return value;
+}
+
+int Decomposition::max(int value) const {
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_INT, MPI_MAX, comm_);
+  return value;
+}
+
+}  // namespace shatter

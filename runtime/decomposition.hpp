@@ -1,0 +1,140 @@
+#pragma once
+// How the time loop is shared between MPI ranks (DESIGN.md "Parallel model",
+// docs/parallel.md "The decomposed time loop").
+//
+// Every rank builds the same global model; the work is divided, the data is
+// replicated. The elements are cut into granules of ElementForces::kGranule
+// consecutive elements (consecutive in the locality order, so a granule is a
+// compact piece of a body) and METIS k-way partitions the granule graph (two
+// granules adjacent when they share nodes, weighted by the number of shared
+// nodes; vertex weight = elements). A rank
+//   - OWNS the elements of its granules and TOUCHES their nodes;
+//   - computes its owned elements and a ghost layer: every element with a
+//     node it touches (so a touched node has its whole element star here and
+//     gets, from ElementForces' fixed block/color order, the serial bits);
+//   - integrates its touched nodes; every rank touching a node integrates it
+//     with the same bits, so no force is summed over ranks;
+//   - receives each step the positions of its ghost-only nodes (held through
+//     the ghost layer, not touched) from their owner, the smallest rank
+//     touching them (Halo, nonblocking).
+// Global sums (energies, momenta, work, body rows) are summed per granule by
+// the granule's owner - node sums over each node's HOME granule, the granule
+// of the first element of its star - exchanged by an exact MPI_Allreduce of
+// the per-granule array (each entry has one non-zero contribution, so the
+// reduction adds only zeros) and combined in granule order: every rank gets
+// the same bits as a serial run, for any decomposition.
+// With one rank (or MPI not initialised) nothing is communicated.
+#include <mpi.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "kernels/types.hpp"
+#include "runtime/model.hpp"
+
+namespace shatter {
+
+class Halo;
+
+/// A subset of the nodes, listed identically on every rank (ascending), whose
+/// owners' values are shared with every rank (Decomposition::share).
+struct SharedNodes {
+  std::vector<Index> nodes;                 ///< the subset, ascending
+  std::vector<Index> by_rank;               ///< the subset grouped by owner rank, ascending within
+  std::vector<int> counts, displacements;   ///< per rank: nodes it owns in the subset, offsets in by_rank
+};
+
+class Decomposition {
+ public:
+  /// Partitions `model`'s elements over the ranks of `comm` (every rank
+  /// computes the same partition; no communication). Throws InputError when
+  /// the mesh has fewer granules than ranks.
+  Decomposition(const Model& model, MPI_Comm comm);
+  ~Decomposition();
+  Decomposition(const Decomposition&) = delete;
+  Decomposition& operator=(const Decomposition&) = delete;
+
+  /// Recompute the node lists after node splitting (granule ownership stays).
+  void rebuild_nodes();
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool distributed() const { return size_ > 1; }
+  MPI_Comm comm() const { return comm_; }
+
+  Index num_granules() const { return static_cast<Index>(granule_rank_.size()); }
+  int granule_rank(Index g) const { return granule_rank_[g]; }
+  bool owns_granule(Index g) const { return granule_rank_[g] == rank_; }
+  std::span<const Index> owned_granules() const { return owned_granules_; }
+  /// Owned elements and the ghost layer, ascending.
+  std::span<const Index> local_elements() const { return local_elements_; }
+  /// Nodes of local_elements(), ascending.
+  std::span<const Index> held_nodes() const { return held_nodes_; }
+  /// Nodes of owned elements (integrated here), ascending.
+  std::span<const Index> touched_nodes() const { return touched_nodes_; }
+  /// Nodes whose home granule is g (the granule of their first element), ascending.
+  std::span<const Index> home_nodes(Index g) const {
+    return {home_nodes_.data() + home_offsets_[g], static_cast<size_t>(home_offsets_[g + 1] - home_offsets_[g])};
+  }
+  Index home_granule(Index node) const { return home_granule_[node]; }
+  /// The smallest rank touching the node.
+  int node_owner(Index node) const { return node_ranks_[node_rank_offsets_[node]]; }
+  Index owned_elements() const { return owned_elements_; }
+
+  /// Apply body(i) to every touched node, in parallel (all nodes on 1 rank).
+  template <class Body>
+  void for_touched(Index num_nodes, Body body) const;
+
+  /// Positions of the ghost-only nodes from their owners.
+  void update_ghost_only(std::span<Vec3> x);
+  /// Bytes this rank sends per update_ghost_only.
+  std::size_t ghost_bytes() const;
+
+  /// The plan of share() for `nodes` (ascending, the same on every rank).
+  SharedNodes shared_nodes(std::vector<Index> nodes) const;
+  /// After the call every rank holds the owners' values of the plan's nodes in `arrays`.
+  void share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays);
+  /// Rank 0 receives the owners' values of every node (the others' arrays are unchanged).
+  void gather_to_root(std::span<const std::span<Vec3>> arrays);
+
+  /// In place: per-granule partials [g * k + c], non-zero only on the
+  /// granule's owner, become the same complete array on every rank (exact).
+  void combine_granules(std::span<double> values);
+  /// Global minimum (exact in any order).
+  double min(double value) const;
+  /// Global maximum of an int.
+  int max(int value) const;
+
+ private:
+  const Model& model_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int rank_ = 0, size_ = 1;
+  std::vector<int> granule_rank_;
+  std::vector<Index> owned_granules_;
+  Index owned_elements_ = 0;
+  std::vector<Index> node_rank_offsets_;
+  std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending
+  std::vector<Index> local_elements_, held_nodes_, touched_nodes_;
+  std::vector<Index> home_granule_, home_offsets_, home_nodes_;
+  std::unique_ptr<Halo> halo_;
+  SharedNodes all_nodes_;
+};
+
+template <class Body>
+void Decomposition::for_touched(Index num_nodes, Body body) const {
+  if (!distributed()) {
+    tbb::parallel_for(tbb::blocked_range<Index>(0, num_nodes, 1024), [&](const tbb::blocked_range<Index>& r) {
+      for (Index i = r.begin(); i < r.end(); ++i) body(i);
+    });
+  } else {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, touched_nodes_.size(), 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t k = r.begin(); k < r.end(); ++k) body(touched_nodes_[k]);
+                      });
+  }
+}
+
+}  // namespace shatter
