@@ -47,6 +47,12 @@ Simulation::Simulation(Model& model, RunOptions options)
     if (model_.scene.fracture_enabled())
       throw InputError(model_.scene.file + ": materials with a fracture block run on one MPI rank only (for now); "
                        "run with mpirun -np 1 and --threads T");
+    // Every rank meshed the scene itself: check that they agree.
+    std::uint64_t fp[2] = {model_fingerprint(model_), ~model_fingerprint(model_)};
+    MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, dec_->comm());
+    if (fp[0] != ~fp[1])
+      throw Error(model_.scene.file + ": the MPI ranks built different models from the scene (meshing differs "
+                  "between processes)");
     elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
   }
   const Index n = mesh.num_nodes();
@@ -260,6 +266,24 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   dec_->rebuild_nodes();
 }
 
+void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason) {
+  if (dec_->distributed()) {
+    // Every node's values from its owner; reactions through a nodal array.
+    std::vector<Vec3> reaction(model_.mesh.num_nodes(), Vec3::Zero());
+    for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction[bc_nodes_[b]] = s.reaction[b];
+    const std::span<Vec3> arrays[] = {s.x, s.v, s.a, s.f_int, s.f_ext, reaction};
+    dec_->gather_to_root(arrays);
+    for (size_t b = 0; b < bc_nodes_.size(); ++b) s.reaction[b] = reaction[bc_nodes_[b]];
+  }
+  std::string failure;
+  if (dec_->rank() == 0) try {
+      write_checkpoint(path, model_, s, reason);
+    } catch (const Error& e) {
+      failure = e.what();
+    }
+  if (dec_->max(failure.empty() ? 0 : 1)) throw Error(failure.empty() ? "writing the checkpoint failed on rank 0" : failure);
+}
+
 void Simulation::save_state(SimulationState& s) const {
   s.step = step_;
   s.time = time_;
@@ -455,13 +479,10 @@ long Simulation::run() {
   Progress progress(scene.end_time, opt_.quiet || !root);
   if (!restored_) write_outputs(field_every > 0);
   // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
-  // last good state when a step fails; not for scenes with fracture, nor on
-  // several ranks (yet).
+  // last good state when a step fails; not for scenes with fracture. On
+  // several ranks, rank 0 writes the owners' values (save_checkpoint).
   const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
-  const bool checkpoints = !opt_.out_dir.empty() && !fracture_ && !dec_->distributed();
-  if (dec_->distributed() && scene.checkpoint && root && !opt_.quiet)
-    std::fprintf(stderr, "warning: %s: checkpoints are written on one MPI rank only (for now); this run on %d "
-                 "ranks writes none\n", scene.file.c_str(), dec_->size());
+  const bool checkpoints = !opt_.out_dir.empty() && !fracture_;
   SimulationState good;  // the state before the current step
   auto last_checkpoint = std::chrono::steady_clock::now();
   const double tiny = 1e-12 * scene.end_time;
@@ -473,7 +494,7 @@ long Simulation::run() {
       if (!checkpoints) throw;
       progress.finish();
       try {
-        write_checkpoint(checkpoint, model_, good, e.what());
+        save_checkpoint(checkpoint, good, e.what());
       } catch (const Error& w) {
         throw Error(std::string(e.what()) + "\n" + w.what());
       }
@@ -488,20 +509,20 @@ long Simulation::run() {
     const int stop = last ? 0 : dec_->max(stop_signal());
     const auto now = std::chrono::steady_clock::now();
     const std::optional<CheckpointSpec>& every = scene.checkpoint;
+    // Rank 0's clock decides for every rank.
     const bool due = every && ((every->every_steps > 0 && step_ % every->every_steps == 0) ||
-                               (every->every_seconds > 0 &&
-                                now - last_checkpoint >= std::chrono::duration<double>(every->every_seconds)));
+                               dec_->max(root && every->every_seconds > 0 &&
+                                         now - last_checkpoint >= std::chrono::duration<double>(every->every_seconds)));
     if (checkpoints && (due || stop) && !last) {
       save_state(good);
-      write_checkpoint(checkpoint, model_, good);
+      save_checkpoint(checkpoint, good);
       last_checkpoint = now;
     }
     if (stop) {
       progress.finish();
       const std::string where = checkpoints ? "; continue with --restart " + checkpoint.string()
                                 : fracture_ ? "; no checkpoint written (a scene with fracture cannot be restarted yet)"
-                                : dec_->distributed() ? "; no checkpoint written (runs on several ranks write none yet)"
-                                                      : "; no checkpoint written (no output folder)";
+                                            : "; no checkpoint written (no output folder)";
       throw Error("stopped by signal " + std::to_string(stop) + " after step " + std::to_string(step_) + where);
     }
   }

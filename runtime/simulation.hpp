@@ -104,6 +104,10 @@ class Simulation {
   void update_ledger();
   void write_outputs(bool fields);
   void write_summary(double wall_seconds);
+  /// Writes `s` (this rank's copy of the state, completed from the owners on
+  /// several ranks) to `path` from rank 0; collective; throws Error on every
+  /// rank when the write fails.
+  void save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason = "");
   double next_dt() const;
 
   /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
