@@ -24,69 +24,16 @@
 #include "runtime/contact_stage.hpp"
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
+#include "run_checks.hpp"
 #include "scene_text.hpp"
 
 using namespace shatter;
+using shatter::test::body_centre;
+using shatter::test::body_velocity;
+using shatter::test::count_penetrations;
 using shatter::test::scene_from_text;
 
 namespace {
-
-/// Centre-of-mass velocity of body b, m/s.
-Vec3 body_velocity(const Simulation& sim, int b) {
-  const Model& m = sim.model();
-  Vec3 mv = Vec3::Zero();
-  double mass = 0;
-  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
-    if (m.mesh.node_body[i] == b) {
-      mv += m.mass[i] * sim.velocities()[i];
-      mass += m.mass[i];
-    }
-  return mv / mass;
-}
-
-/// Centre of mass of body b, m.
-Vec3 body_centre(const Simulation& sim, int b) {
-  const Model& m = sim.model();
-  Vec3 mx = Vec3::Zero();
-  double mass = 0;
-  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
-    if (m.mesh.node_body[i] == b) {
-      mx += m.mass[i] * sim.positions()[i];
-      mass += m.mass[i];
-    }
-  return mx / mass;
-}
-
-/// The independent penetration check: the number of surface vertices of each body that
-/// lie inside a tetrahedron of another body by more than `depth` times that
-/// tetrahedron's smallest altitude (all four barycentric coordinates above `depth`).
-/// Brute force over the volume meshes with a bounding-box filter; no DCR code involved.
-int count_penetrations(const Simulation& sim, double depth = 1e-6) {
-  const Model& m = sim.model();
-  const Mesh& mesh = m.mesh;
-  const auto x = sim.positions();
-  const auto& vertices = sim.contact()->surface().vertices;
-  int found = 0;
-  for (Index e = 0; e < mesh.num_elements(); ++e) {
-    const Index* t = mesh.element(e);
-    const Vec3 &a = x[t[0]], &b = x[t[1]], &c = x[t[2]], &d = x[t[3]];
-    const Vec3 lo = a.cwiseMin(b).cwiseMin(c).cwiseMin(d), hi = a.cwiseMax(b).cwiseMax(c).cwiseMax(d);
-    Mat3 J;
-    J.col(0) = b - a;
-    J.col(1) = c - a;
-    J.col(2) = d - a;
-    const Mat3 J_inv = J.inverse();
-    for (const Index v : vertices) {
-      if (mesh.node_body[v] == mesh.elem_body[e]) continue;
-      const Vec3& p = x[v];
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-      const Vec3 l = J_inv * (p - a);
-      const double l0 = 1.0 - l.sum();
-      if (std::min({l0, l.x(), l.y(), l.z()}) > depth) ++found;
-    }
-  }
-  return found;
-}
 
 const char* kSteel = "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n";
 
