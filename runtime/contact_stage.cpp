@@ -11,6 +11,8 @@ namespace shatter {
 ContactStage::ContactStage(const Model& model, const ContactSpec& spec) {
   options_.restitution = spec.restitution;
   options_.friction = spec.friction;
+  options_.max_sweeps = spec.max_sweeps;
+  margin_fraction_ = spec.search_margin;
   rebuild(model.mesh);
 }
 
@@ -21,7 +23,7 @@ void ContactStage::rebuild(const Mesh& mesh) {
   for (const auto& [a, b] : surface_.edges) lengths.push_back((mesh.reference[a] - mesh.reference[b]).norm());
   if (!lengths.empty()) {
     std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-    margin_ = 0.1 * lengths[lengths.size() / 2];
+    margin_ = margin_fraction_ * lengths[lengths.size() / 2];
   }
   have_candidates_ = false;
 }

@@ -4,7 +4,8 @@
 // surface; fracture rebuilds it with the crack faces it opens.
 //
 // Candidate reuse (a Verlet list): the search runs on swept boxes inflated by
-// a margin (1.01 delta) and its candidates serve the following steps for as
+// a margin (1.01 delta; delta = contact.search_margin, default 0.1, times the
+// median surface edge) and its candidates serve the following steps for as
 // long as every surface node stays within delta (max norm) of where it was at
 // that search, at the start and at the end of the step. A primitive's swept
 // box over such a step then lies inside its inflated box of the search (the
@@ -42,7 +43,8 @@ class ContactStage {
   double search_seconds() const { return search_seconds_; }
   double dcr_seconds() const { return dcr_seconds_; }
   long searches() const { return searches_; }
-  /// The reuse margin delta, m: a tenth of the median surface edge length.
+  /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
+  /// median surface edge length.
   double margin() const { return margin_; }
 
  private:
@@ -51,6 +53,7 @@ class ContactStage {
 
   ContactSurface surface_;
   DcrOptions options_;
+  double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
   bool have_candidates_ = false;
   ContactPairs pairs_;   ///< candidates of the last search (inflated boxes)

@@ -199,13 +199,15 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
     r.fail("name", "a plain name usable as a folder name (no '/')", root["name"]);
 
   const YAML::Node time = r.required(root, "", "time");
-  r.only_keys(time, "time", {"end", "dt", "safety"});
+  r.only_keys(time, "time", {"end", "dt", "safety", "fracture_check_every"});
   s.end_time = r.positive(r.required(time, "time", "end"), "time.end");
   if (time["dt"]) s.fixed_dt = r.positive(time["dt"], "time.dt");
   if (time["safety"]) {
     s.safety = r.positive(time["safety"], "time.safety");
     if (s.safety > 1.0) r.fail("time.safety", "a fraction of the stable step in (0, 1]", time["safety"]);
   }
+  if (time["fracture_check_every"])
+    s.fracture_check_every = r.count(time["fracture_check_every"], "time.fracture_check_every", 1);
 
   if (const YAML::Node out = root["output"]) {
     r.only_keys(out, "output", {"every", "history_every"});
@@ -322,7 +324,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   if (const YAML::Node c = root["contact"]) {
     ContactSpec cs;
     if (!c.IsNull()) {
-      r.only_keys(c, "contact", {"friction", "restitution"});
+      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin"});
       if (c["friction"]) {
         cs.friction = r.number(c["friction"], "contact.friction");
         if (cs.friction < 0) r.fail("contact.friction", "a Coulomb coefficient >= 0", c["friction"]);
@@ -330,6 +332,12 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
       if (c["restitution"]) {
         cs.restitution = r.number(c["restitution"], "contact.restitution");
         if (cs.restitution < 0 || cs.restitution > 1) r.fail("contact.restitution", "a value in [0, 1]", c["restitution"]);
+      }
+      if (c["max_sweeps"]) cs.max_sweeps = static_cast<int>(r.count(c["max_sweeps"], "contact.max_sweeps", 1));
+      if (c["search_margin"]) {
+        cs.search_margin = r.number(c["search_margin"], "contact.search_margin");
+        if (!(cs.search_margin >= 0))
+          r.fail("contact.search_margin", "a fraction of the median surface edge >= 0", c["search_margin"]);
       }
     }
     s.contact = cs;

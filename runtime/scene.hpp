@@ -49,6 +49,8 @@ struct BoundaryConditionSpec {
 struct ContactSpec {
   double friction = 0.0;     ///< Coulomb mu
   double restitution = 1.0;  ///< e in [0, 1]
+  int max_sweeps = 100;       ///< cap on DCR Gauss-Seidel sweeps per step (contact.max_sweeps)
+  double search_margin = 0.1; ///< candidate reuse margin, fraction of the median surface edge (contact.search_margin)
 };
 
 struct CheckpointSpec {
@@ -62,6 +64,7 @@ struct Scene {
   double end_time = 0;
   std::optional<double> fixed_dt;
   double safety = 0.5;
+  long fracture_check_every = 1;  ///< steps between facet checks (time.fracture_check_every)
   long output_every = -1;  ///< steps between field outputs; -1 = default (about 20 frames)
   long history_every = 1;
   std::vector<MaterialSpec> materials;

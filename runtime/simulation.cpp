@@ -218,7 +218,7 @@ void Simulation::step() {
   }
   time_ += dt;
   ++step_;
-  if (fracture_) apply_fracture();
+  if (fracture_ && step_ % model_.scene.fracture_check_every == 0) apply_fracture();
   update_ledger();
 }
 

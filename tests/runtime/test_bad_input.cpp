@@ -81,6 +81,10 @@ TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {
        kGood + "boundary_conditions:\n  - {body: b, region: {box: [[5, 5, 5], [6, 6, 6]]}, velocity: [0, null, null]}\n",
        {"boundary_conditions[0].region", "no node"}},
       {"restitution_range", kGood + "contact: {restitution: 1.5}\n", {"contact.restitution", "[0, 1]"}},
+      {"max_sweeps_zero", kGood + "contact: {max_sweeps: 0}\n", {"contact.max_sweeps", "integer >= 1"}},
+      {"search_margin_negative", kGood + "contact: {search_margin: -0.1}\n", {"contact.search_margin", ">= 0"}},
+      {"fracture_check_every_fraction", replaced(kGood, "time: {", "time: {fracture_check_every: 2.5, "),
+       {"time.fracture_check_every", "integer >= 1"}},
       {"invalid_yaml", kGood + "time: [\n", {"not valid YAML"}},
   };
   for (const Case& c : cases) {
