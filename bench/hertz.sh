@@ -9,7 +9,8 @@
 # v the approach speed; the peak contact force m dv/dt of one sphere's centre
 # of mass (centred difference over 2k steps, k = 5) against
 # F_max = 4/3 E* sqrt(R*) d_max^(3/2), d_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5);
-# and the wall time of each run (--threads 1).
+# and the wall time of each run (--threads 1). The figures come from
+# hertz_metrics in bench/speed_accuracy/speed_accuracy.py.
 # Run:     bash bench/hertz.sh BUILD_DIR [V] [sizes...]   (default V = 50 m/s,
 #          sizes 1.0e-3 8.0e-4 6.0e-4 m)
 # Output:  bench/results/hertz.csv and a table on stdout.
@@ -30,52 +31,22 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 half=$(python3 -c "print($speed / 2)")
-cat > "$work/hertz.yaml" <<EOF
-name: hertz
-time:
-  end: 1.8e-5
-output:
-  every: 0
-  history_every: 1
-materials:
-  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}
-bodies:
-  - name: left
-    material: steel
-    mesh: {shape: sphere, radius: 5.0e-3, center: [-5.01e-3, 0, 0], element_size: 1.0e-3, order: 1}
-    initial_velocity: [$half, 0, 0]
-  - name: right
-    material: steel
-    mesh: {shape: sphere, radius: 5.0e-3, center: [5.01e-3, 0, 0], element_size: 1.0e-3, order: 1}
-    initial_velocity: [-$half, 0, 0]
-contact: {friction: 0.0, restitution: 1.0}
-EOF
 
 echo "h,elements,steps,t_contact,t_hertz,duration_error,f_peak,f_hertz,force_error,energy_error,wall_time" > "$out/hertz.csv"
 for h in "${sizes[@]}"; do
   dir="$work/h$h"
-  "$build/apps/shatter" run "$work/hertz.yaml" --out "$dir" --threads 1 --quiet \
-    --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
-  python3 - "$dir" "$h" "$speed" >> "$out/hertz.csv" <<'EOF'
-import csv, json, math, sys
+  "$build/apps/shatter" run "$here/speed_accuracy/hertz_spheres.yaml" --out "$dir" --threads 1 --quiet \
+    --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h" \
+    --set "bodies[0].initial_velocity=[$half,0,0]" --set "bodies[1].initial_velocity=[-$half,0,0]"
+  /usr/bin/python3 - "$dir" "$h" "$speed" "$here/speed_accuracy" >> "$out/hertz.csv" <<'EOF'
+import json, sys
 d, h, v = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
-E, nu, rho, R = 210.0e9, 0.3, 7850.0, 5.0e-3
+sys.path.insert(0, sys.argv[4])
+from speed_accuracy import hertz_metrics
 s = json.load(open(d + "/summary.json"))
-hist = list(csv.DictReader(open(d + "/history.csv")))
-t_on = [float(r["time"]) for r in hist if int(r["contacts"]) > 0]
-rows = [r for r in csv.DictReader(open(d + "/bodies.csv")) if r["body"] == "left"]
-m = float(rows[0]["mass"])  # the meshed sphere's mass
-ms, Rs, Es = m / 2, R / 2, E / (2 * (1 - nu * nu))
-t_h = 2.87 * (ms * ms / (Rs * Es * Es * v)) ** 0.2
-d_max = (15 * ms * v * v / (16 * Es * math.sqrt(Rs))) ** 0.4
-f_h = 4.0 / 3.0 * Es * math.sqrt(Rs) * d_max ** 1.5
-t = [float(r["time"]) for r in rows]
-u = [float(r["vx"]) for r in rows]
-k = 5
-f_peak = max(abs(m * (u[i + k] - u[i - k]) / (t[i + k] - t[i - k])) for i in range(k, len(t) - k))
-dur = t_on[-1] - t_on[0] if t_on else 0.0
-print(f"{h},{s['elements']},{s['steps']},{dur:.6e},{t_h:.6e},{dur / t_h - 1:+.4f},{f_peak:.6e},{f_h:.6e},"
-      f"{f_peak / f_h - 1:+.4f},{s['energy_error']:+.3e},{s['wall_time']:.1f}")
+m = hertz_metrics(d, h, v)
+print(f"{h},{s['elements']},{s['steps']},{m['t_contact']:.6e},{m['t_hertz']:.6e},{m['duration_error']:+.4f},"
+      f"{m['f_peak']:.6e},{m['f_hertz']:.6e},{m['force_error']:+.4f},{s['energy_error']:+.3e},{s['wall_time']:.1f}")
 EOF
   tail -1 "$out/hertz.csv"
 done
