@@ -3,36 +3,34 @@
 // and the independent penetration check (point in tetrahedron on the volume
 // meshes, brute force, no DCR code involved).
 #include <algorithm>
+#include <span>
 
 #include "runtime/contact_stage.hpp"
 #include "runtime/simulation.hpp"
 
 namespace shatter::test {
 
-/// Centre-of-mass velocity of body b, m/s.
-inline Vec3 body_velocity(const Simulation& sim, int b) {
+/// Mass-weighted mean over the nodes of body b of a nodal array (positions, velocities).
+inline Vec3 body_mean(const Simulation& sim, int b, std::span<const Vec3> field) {
   const Model& m = sim.model();
-  Vec3 mv = Vec3::Zero();
+  Vec3 sum = Vec3::Zero();
   double mass = 0;
   for (Index i = 0; i < m.mesh.num_nodes(); ++i)
     if (m.mesh.node_body[i] == b) {
-      mv += m.mass[i] * sim.velocities()[i];
+      sum += m.mass[i] * field[i];
       mass += m.mass[i];
     }
-  return mv / mass;
+  return sum / mass;
+}
+
+/// Centre-of-mass velocity of body b, m/s.
+inline Vec3 body_velocity(const Simulation& sim, int b) {
+  return body_mean(sim, b, sim.velocities());
 }
 
 /// Centre of mass of body b, m.
 inline Vec3 body_centre(const Simulation& sim, int b) {
-  const Model& m = sim.model();
-  Vec3 mx = Vec3::Zero();
-  double mass = 0;
-  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
-    if (m.mesh.node_body[i] == b) {
-      mx += m.mass[i] * sim.positions()[i];
-      mass += m.mass[i];
-    }
-  return mx / mass;
+  return body_mean(sim, b, sim.positions());
 }
 
 /// The number of surface vertices of each body that lie inside a tetrahedron of another

@@ -204,59 +204,58 @@ void expect_diagnosis(const BinaryRun& r) {
   EXPECT_TRUE(r.checkpoint);
 }
 
+/// A 2 cm cube of `material` (element size 1 cm) at `centre` moving at `v`, as a YAML flow map.
+std::string cube(const std::string& name, const std::string& material, const Vec3& centre,
+                 const Vec3& v) {
+  return "{name: " + name + ", material: " + material +
+         ", mesh: {shape: box, size: [0.02, 0.02, 0.02], center: " + vec(centre) +
+         ", element_size: 0.01}, initial_velocity: " + vec(v) + "}";
+}
+
+/// Two bodies colliding (frictionless, elastic), run watched to `end`; the run must have had
+/// contact.
+Started run_cube_pair(const std::string& name, const std::string& materials, const std::string& a,
+                      const std::string& b, double end) {
+  Started r = start(name, two_body_scene(name, materials, a, b));
+  r.w = run_watched(*r.sim, end);
+  std::printf(
+      "%s: %ld steps, dt %.3e, contact steps %ld, energy error max %.3e final %+.3e, v %s %s\n",
+      name.c_str(), r.w.steps, r.sim->dt(), r.w.contact_steps, r.w.max_energy_error,
+      r.sim->energy_error(), vec(body_velocity(*r.sim, 0)).c_str(),
+      vec(body_velocity(*r.sim, 1)).c_str());
+  EXPECT_GT(r.w.contact_steps, 0) << "no contact";
+  return r;
+}
+
 }  // namespace
 
 // nu = 0.499: the dilatational speed is 13 x the shear speed, so the step is 13 x
 // shorter than the deformation needs, and TET4 locks (stiff but stable). Two rubber
 // cubes meet at 2 x 1 m/s and separate.
 TEST(Extreme, NearlyIncompressibleCubesCollide) {
-  Model m = build_model(scene_from_text(
-      "incompressible", two_body_scene("incompressible",
-                                       "  rubber: {model: neo_hookean, density: 1000, "
-                                       "youngs_modulus: 1.0e6, poisson_ratio: 0.499}\n",
-                                       "{name: a, material: rubber, mesh: {shape: box, size: "
-                                       "[0.02, 0.02, 0.02], center: [-0.0101, 0, 0], "
-                                       "element_size: 0.01}, initial_velocity: [1, 0, 0]}",
-                                       "{name: b, material: rubber, mesh: {shape: box, size: "
-                                       "[0.02, 0.02, 0.02], center: [0.0101, 0.004, 0], "
-                                       "element_size: 0.01}, initial_velocity: [-1, 0, 0]}")));
-  Simulation sim(m, {});
-  const Watch w = run_watched(sim, 4e-3);
-  std::printf(
-      "nu 0.499: %ld steps, dt %.3e, contact steps %ld, energy error max %.3e final %+.3e, v %.3f "
-      "%.3f\n",
-      w.steps, sim.dt(), w.contact_steps, w.max_energy_error, sim.energy_error(),
-      body_velocity(sim, 0).x(), body_velocity(sim, 1).x());
-  ASSERT_GT(w.contact_steps, 0);
-  expect_clean(w, 0.03);
-  EXPECT_LT(body_velocity(sim, 0).x(), 0.0);
-  EXPECT_GT(body_velocity(sim, 1).x(), 0.0);
+  const Started r =
+      run_cube_pair("incompressible",
+                    "  rubber: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e6, "
+                    "poisson_ratio: 0.499}\n",
+                    cube("a", "rubber", Vec3(-0.0101, 0, 0), Vec3(1, 0, 0)),
+                    cube("b", "rubber", Vec3(0.0101, 0.004, 0), Vec3(-1, 0, 0)), 4e-3);
+  expect_clean(r.w, 0.03);
+  EXPECT_LT(body_velocity(*r.sim, 0).x(), 0.0);
+  EXPECT_GT(body_velocity(*r.sim, 1).x(), 0.0);
 }
 
 // E ratio 1e6: a soft cube (E = 1e5 Pa, c_d = 11.6 m/s) hits a stiff one (1e11 Pa) of
 // the same density at rest. The stiff body sets the step (1000 x shorter than the
 // soft body needs: the contact lasts ~2e4 steps); the soft body must not sink in.
 TEST(Extreme, SoftAgainstStiffE1e6) {
-  Model m = build_model(scene_from_text(
-      "soft_stiff", two_body_scene("soft_stiff",
-                                   "  softer: {model: neo_hookean, density: 1000, youngs_modulus: "
-                                   "1.0e5, poisson_ratio: 0.3}\n"
-                                   "  stiff: {model: neo_hookean, density: 1000, youngs_modulus: "
-                                   "1.0e11, poisson_ratio: 0.3}\n",
-                                   "{name: soft, material: softer, mesh: {shape: box, size: [0.02, "
-                                   "0.02, 0.02], center: [-0.0101, 0, 0], "
-                                   "element_size: 0.01}, initial_velocity: [1, 0, 0]}",
-                                   "{name: stiff, material: stiff, mesh: {shape: box, size: [0.02, "
-                                   "0.02, 0.02], center: [0.0101, 0, 0], "
-                                   "element_size: 0.01}}")));
-  Simulation sim(m, {});
-  const Watch w = run_watched(sim, 5e-3);
-  std::printf(
-      "E ratio 1e6: %ld steps, contact steps %ld, energy error max %.3e final %+.3e, v %.3f %.3f\n",
-      w.steps, w.contact_steps, w.max_energy_error, sim.energy_error(), body_velocity(sim, 0).x(),
-      body_velocity(sim, 1).x());
-  ASSERT_GT(w.contact_steps, 0);
-  expect_clean(w, 0.03);
+  const Started r = run_cube_pair(
+      "soft_stiff",
+      "  softer: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e5, poisson_ratio: 0.3}\n"
+      "  stiff: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e11, poisson_ratio: 0.3}\n",
+      cube("soft", "softer", Vec3(-0.0101, 0, 0), Vec3(1, 0, 0)),
+      cube("stiff", "stiff", Vec3(0.0101, 0, 0), Vec3::Zero()), 5e-3);
+  expect_clean(r.w, 0.03);
+  const Simulation& sim = *r.sim;
   // The stiff body was pushed; the soft one gave up most of its momentum.
   EXPECT_GT(body_velocity(sim, 1).x(), 0.5);
   EXPECT_LT(body_velocity(sim, 0).x(), 0.5);
