@@ -205,6 +205,18 @@ void Decomposition::combine_granules(std::span<double> values) {
     MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
 }
 
+std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
+  if (size_ == 1) return {mine.begin(), mine.end()};
+  static_assert(sizeof(Index) == sizeof(int));
+  std::vector<int> counts(size_), displs(size_, 0);
+  const int n = static_cast<int>(mine.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int r = 1; r < size_; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<Index> all(displs[size_ - 1] + counts[size_ - 1]);
+  MPI_Allgatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, comm_);
+  return all;
+}
+
 double Decomposition::min(double value) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MIN, comm_);
   return value;

@@ -103,6 +103,8 @@ class Decomposition {
   /// In place: per-granule partials [g * k + c], non-zero only on the
   /// granule's owner, become the same complete array on every rank (exact).
   void combine_granules(std::span<double> values);
+  /// Every rank's `mine`, concatenated in rank order, on every rank.
+  std::vector<Index> allgather(std::span<const Index> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
   /// Global maximum of an int.

@@ -1,5 +1,6 @@
 #include "runtime/fracture_stage.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "fracture/facet_criterion.hpp"
@@ -31,12 +32,28 @@ CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3
   return cohesive_forces(model_.mesh, topology_, cohesive_, laws_, x, f_int);
 }
 
-Insertion FractureStage::check_and_insert(std::span<const Vec3> x, std::span<const double> stress6) {
+std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6) {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_);
+  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_);
   check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (critical.empty()) return {};
-  return insert_cohesive_elements(model_.mesh, topology_, cohesive_, critical);
+  return critical;
+}
+
+Insertion FractureStage::insert(std::span<const Index> facets) {
+  if (facets.empty()) return {};
+  return insert_cohesive_elements(model_.mesh, topology_, cohesive_, facets);
+}
+
+std::vector<Index> FractureStage::cohesive_nodes() const {
+  const int k = model_.mesh.order == 1 ? 3 : 6;
+  std::vector<Index> nodes;
+  nodes.reserve(static_cast<size_t>(cohesive_.size()) * 2 * k);
+  for (Index c = 0; c < cohesive_.size(); ++c)
+    for (int s = 0; s < 2; ++s)
+      for (int j = 0; j < k; ++j) nodes.push_back(cohesive_.side_nodes[(2 * static_cast<size_t>(c) + s) * 6 + j]);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
 }
 
 Index FractureStage::release() {

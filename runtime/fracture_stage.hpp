@@ -24,9 +24,17 @@ class FractureStage {
   CohesiveEnergy add_forces(std::span<const Vec3> x, std::span<Vec3> f_int);
 
   /// Facets whose traction (from the elements' Cauchy stresses, 6 Voigt
-  /// components per element) reaches the strength become cohesive elements;
-  /// nodes split. Returns what changed (new nodes to fill in by the caller).
-  Insertion check_and_insert(std::span<const Vec3> x, std::span<const double> stress6);
+  /// components per element) reaches the strength, sorted by facet gid.
+  std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6);
+  /// The facets become cohesive elements (in canonical order, whatever the
+  /// order given); nodes split. Returns what changed (new nodes to fill in by
+  /// the caller).
+  Insertion insert(std::span<const Index> facets);
+  /// The nodes of all cohesive elements (both sides), ascending.
+  std::vector<Index> cohesive_nodes() const;
+  const Topology& topology() const { return topology_; }
+  /// The facet of each cohesive element.
+  std::span<const Index> cohesive_facets() const { return cohesive_.facet; }
 
   /// Frees fully debonded facets; returns how many.
   Index release();

@@ -44,16 +44,12 @@ Simulation::Simulation(Model& model, RunOptions options)
       elements_(model) {
   const Mesh& mesh = model_.mesh;
   if (dec_->distributed()) {
-    if (model_.scene.fracture_enabled())
-      throw InputError(model_.scene.file + ": materials with a fracture block run on one MPI rank only (for now); "
-                       "run with mpirun -np 1 and --threads T");
     // Every rank meshed the scene itself: check that they agree.
     std::uint64_t fp[2] = {model_fingerprint(model_), ~model_fingerprint(model_)};
     MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, dec_->comm());
     if (fp[0] != ~fp[1])
       throw Error(model_.scene.file + ": the MPI ranks built different models from the scene (meshing differs "
                   "between processes)");
-    elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
   }
   const Index n = mesh.num_nodes();
   x_ = mesh.reference;
@@ -69,12 +65,6 @@ Simulation::Simulation(Model& model, RunOptions options)
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
   if (model_.scene.contact) {
     contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
-    if (dec_->distributed()) {
-      const std::vector<Index>& v = contact_->surface().vertices;
-      std::vector<Index> vertices(v.begin(), v.end());
-      std::sort(vertices.begin(), vertices.end());
-      surface_nodes_ = std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(vertices)));
-    }
     // DCR treats a node with any prescribed component as immovable.
     contact_inv_mass_.resize(n);
     for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
@@ -85,6 +75,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   }
   ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
   granule_sums_.assign(static_cast<size_t>(dec_->num_granules()) * kGranuleSums, 0.0);
+  share_plans();
   compute_forces();
   update_ledger();
   total0_ = ledger_.total();
@@ -105,6 +96,10 @@ double Simulation::next_dt() const {
 }
 
 void Simulation::compute_forces() {
+  if (cohesive_nodes_) {
+    const std::span<Vec3> arrays[] = {x_};
+    dec_->share(*cohesive_nodes_, arrays);
+  }
   const auto t0 = std::chrono::steady_clock::now();
   last_elements_ = elements_.compute(x_, f_int_, stress6_);
   element_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -223,16 +218,45 @@ void Simulation::step() {
 }
 
 void Simulation::apply_fracture() {
+  // Every rank holds the positions of every cohesive node (compute_forces),
+  // so releases are the same everywhere.
   fracture_->release();
-  const Insertion ins = fracture_->check_and_insert(x_, stress6_);
+  std::vector<Index> critical = fracture_->check(x_, stress6_);
+  if (dec_->distributed()) {
+    // A facet is checked by the owner of its first element, which holds both
+    // elements' stresses; every rank inserts the same list.
+    const Topology& topo = fracture_->topology();
+    std::erase_if(critical, [&](Index f) {
+      const Index e = std::min(topo.facet_elem[f][0], topo.facet_elem[f][1]);
+      return !dec_->owns_granule(e / ElementForces::kGranule);
+    });
+    critical = dec_->allgather(critical);
+  }
+  const Index before = fracture_->cohesive_count();
+  const Insertion ins = fracture_->insert(critical);
   ledger_.cohesive_elements = fracture_->cohesive_count();
-  if (ins.new_nodes.empty()) return;
-  grow_nodes(ins.new_nodes);
+  if (ledger_.cohesive_elements == before) return;
+  if (!ins.new_nodes.empty()) {
+    grow_nodes(ins.new_nodes);
+    if (contact_) contact_->rebuild(model_.mesh);
+  }
+  share_plans();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
   // unchanged).
-  compute_forces();
-  if (contact_) contact_->rebuild(model_.mesh);
+  if (!ins.new_nodes.empty()) compute_forces();
+}
+
+void Simulation::share_plans() {
+  if (!dec_->distributed()) return;
+  elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
+  auto plan = [&](std::vector<Index> nodes) { return std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(nodes))); };
+  if (contact_) {
+    std::vector<Index> vertices(contact_->surface().vertices.begin(), contact_->surface().vertices.end());
+    std::sort(vertices.begin(), vertices.end());
+    surface_nodes_ = plan(std::move(vertices));
+  }
+  if (fracture_ && fracture_->cohesive_count() > 0) cohesive_nodes_ = plan(fracture_->cohesive_nodes());
 }
 
 void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {
@@ -363,14 +387,27 @@ void Simulation::update_ledger() {
                                               std::abs(ledger_.external_work));
 }
 
+std::array<std::span<const Vec3>, 2> Simulation::root_state(std::vector<Vec3>& x, std::vector<Vec3>& v) {
+  if (!dec_->distributed()) return {x_, v_};
+  x = x_;
+  v = v_;
+  const std::span<Vec3> arrays[] = {x, v};
+  dec_->gather_to_root(arrays);
+  return {x, v};
+}
+
 void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
+  const bool root = dec_->rank() == 0;
+  // Every node's x and v on rank 0 (gathered on several ranks), when needed.
+  std::vector<Vec3> x_all, v_all;
+  std::array<std::span<const Vec3>, 2> xv;
+  if (fracture_ || (fields && fields_)) xv = root_state(x_all, v_all);
   std::optional<Fragments> frags;
-  if (fracture_) {
-    frags = fracture_->fragments(x_, v_, model_.mass);
+  if (fracture_ && root) {
+    frags = fracture_->fragments(xv[0], xv[1], model_.mass);
     ledger_.fragments = frags->count();
   }
-  const bool root = dec_->rank() == 0;
   const Ledger& l = ledger_;
   if (root) {
     *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
@@ -411,25 +448,20 @@ void Simulation::write_outputs(bool fields) {
   if (fields && fields_) {
     // Rank 0 writes every row (from the owners' values); the others take
     // part in the collective writes with none.
-    std::vector<Vec3> u, vel;
+    std::vector<Vec3> u;
     std::vector<double> stress, vm;
     FieldFrame f;
     f.step = static_cast<int>(step_);
     f.time = time_;
     Mesh empty;
     empty.order = mesh.order;
-    u = x_;
-    vel = v_;
-    if (dec_->distributed()) {
-      const std::span<Vec3> arrays[] = {u, vel};
-      dec_->gather_to_root(arrays);
-    }
     std::vector<int> fragment_id;
     if (root) {
-      element_stresses(model_, u, stress, vm);
-      for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] -= mesh.reference[i];
+      element_stresses(model_, xv[0], stress, vm);
+      u.resize(mesh.num_nodes());
+      for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] = xv[0][i] - mesh.reference[i];
       f.displacement = u;
-      f.velocity = vel;
+      f.velocity = xv[1];
       f.stress = stress;
       f.von_mises = vm;
       f.body = mesh.elem_body;
@@ -529,15 +561,18 @@ long Simulation::run() {
   progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   fields_.reset();
-  if (!opt_.out_dir.empty() && root) {
+  if (!opt_.out_dir.empty()) {
     if (fracture_) write_fragments();
-    write_summary(wall);
+    if (root) write_summary(wall);
   }
   return step_;
 }
 
 void Simulation::write_fragments() {
-  const Fragments frags = fracture_->fragments(x_, v_, model_.mass);
+  std::vector<Vec3> x_all, v_all;
+  const auto xv = root_state(x_all, v_all);
+  if (dec_->rank() != 0) return;
+  const Fragments frags = fracture_->fragments(xv[0], xv[1], model_.mass);
   CsvWriter out(opt_.out_dir / "fragments.csv",
                 {"id", "mass", "volume", "cx", "cy", "cz", "vx", "vy", "vz", "elements"});
   for (Index k = 0; k < frags.count(); ++k) {
@@ -585,7 +620,16 @@ void Simulation::write_summary(double wall) {
   j.add("cohesive_elements", l.cohesive_elements);
   j.add("fragments", l.fragments);
   j.add("contact_capped_steps", l.contact_capped_steps);
-  if (fracture_) j.add("fracture_check_time", fracture_->check_seconds());
+  if (fracture_) {
+    j.add("fracture_check_time", fracture_->check_seconds());
+    // Cohesive elements between elements of different ranks: cracks across subdomains.
+    long across = 0;
+    for (Index f : fracture_->cohesive_facets()) {
+      const auto& fe = fracture_->topology().facet_elem[f];
+      across += dec_->granule_rank(fe[0] / ElementForces::kGranule) != dec_->granule_rank(fe[1] / ElementForces::kGranule);
+    }
+    j.add("cohesive_elements_across_ranks", across);
+  }
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());
     j.add("contact_searches", contact_->searches());

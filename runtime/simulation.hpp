@@ -119,7 +119,11 @@ class Simulation {
   std::unique_ptr<Decomposition> dec_;
   ElementForces elements_;
   std::vector<double> granule_sums_;  ///< [g * kGranuleSums + field], this rank's granules only
-  std::unique_ptr<SharedNodes> surface_nodes_;  ///< contact surface vertices shared by all ranks
+  std::unique_ptr<SharedNodes> surface_nodes_;   ///< contact surface vertices shared by all ranks
+  std::unique_ptr<SharedNodes> cohesive_nodes_;  ///< cohesive element nodes shared by all ranks
+  /// After a topology change on several ranks: restrict the element loop to
+  /// the local elements, renew the plans of the shared nodes.
+  void share_plans();
   std::vector<Vec3> x_, v_, a_, f_int_, f_ext_;
   std::vector<double> inv_mass_;
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
@@ -142,6 +146,9 @@ class Simulation {
   void apply_fracture();
   void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
   void write_fragments();
+  /// x and v of every node on rank 0: the own arrays on one rank, else
+  /// gathered from the owners into `x` and `v` (collective).
+  std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);
 };
 
 }  // namespace shatter

@@ -10,7 +10,7 @@ namespace shatter::test {
 
 /// Write `yaml` to a file named `name`.yaml in a test folder; return its path.
 inline std::string write_scene(const std::string& name, const std::string& yaml) {
-  const auto dir = std::filesystem::temp_directory_path() / "shatter_test_scenes";
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_scenes";
   std::filesystem::create_directories(dir);
   const auto path = dir / (name + ".yaml");
   std::ofstream(path) << yaml;

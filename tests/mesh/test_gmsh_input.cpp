@@ -79,7 +79,7 @@ TEST(GmshInput, SphereAndTubeVolumes) {
 
 TEST(GmshInput, MshFileRoundTripV2AndV4) {
   // Write a two-tet mesh in both formats by hand and read it back.
-  const auto dir = std::filesystem::temp_directory_path() / "shatter_msh_test";
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_msh_test";
   std::filesystem::create_directories(dir);
   const std::string v2 = (dir / "two.msh").string();
   {
@@ -105,7 +105,7 @@ TEST(GmshInput, MshFileRoundTripV2AndV4) {
 }
 
 TEST(GmshInput, BadMeshesAreRejectedWithTheElementId) {
-  const auto dir = std::filesystem::temp_directory_path() / "shatter_msh_test";
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_msh_test";
   std::filesystem::create_directories(dir);
   const std::string inv = (dir / "inverted.msh").string();
   {

@@ -194,7 +194,7 @@ TEST(Scenes, DISABLED_KnownDefects) {
 TEST(Scenes, PlotWritesPngs) {
   if (std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") != 0)
     GTEST_SKIP() << "/usr/bin/python3 has no matplotlib";
-  const auto out = std::filesystem::temp_directory_path() / "shatter_test_plot";
+  const auto out = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_plot";
   std::filesystem::remove_all(out);
   {
     Model model = build_model(load_scene(scene_path("spheres_impact")));
@@ -213,7 +213,7 @@ TEST(Scenes, PlotWritesPngs) {
     ASSERT_TRUE(std::filesystem::is_regular_file(path)) << path;
     EXPECT_GT(std::filesystem::file_size(path), 1000u) << path;
   }
-  const auto empty = std::filesystem::temp_directory_path() / "shatter_test_plot_empty";
+  const auto empty = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_plot_empty";
   std::filesystem::create_directories(empty);
   const int missing = std::system((shatter + " plot " + empty.string() + " 2> /dev/null").c_str());
   ASSERT_TRUE(WIFEXITED(missing));

@@ -97,7 +97,7 @@ TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {
 }
 
 TEST(BadInput, InvertedElementInAMeshFileIsNamed) {
-  const auto dir = std::filesystem::temp_directory_path() / "shatter_test_scenes";
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_scenes";
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "inverted.msh")
       << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0 0 -1\n"

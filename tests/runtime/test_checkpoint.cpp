@@ -76,7 +76,7 @@ std::string contact_scene(const std::string& name) {
 }
 
 fs::path test_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "shatter_test_checkpoint" / name;
+  const fs::path dir = fs::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_checkpoint" / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
