@@ -58,7 +58,6 @@ void ElementForces::restrict_to(std::span<const Index> elements, std::span<const
 ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int,
                                          std::span<double> stress6) const {
   const Mesh& mesh = model_.mesh;
-  const Index ne = mesh.num_elements();
   const Index* conn = mesh.conn.data();
   const int* mat = mesh.elem_material.data();
   const NeoHookean* mats = model_.materials.data();
