@@ -30,8 +30,8 @@ bool distinct_nodes(const ContactPair& p) {
 }  // namespace
 
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std::span<const Vec3> x_old,
-                           std::span<Vec3> v, std::span<const double> inv_mass, const DcrOptions& options,
-                           const DcrPairColors& colors) {
+                           std::span<Vec3> v, std::span<const double> inv_mass, double dt,
+                           const DcrOptions& options, const DcrPairColors& colors) {
   const size_t n_nodes = x_new.size();
   SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
                   "resolve_contacts: nodal arrays differ in size (x_new " << n_nodes << ", x_old " << x_old.size()
@@ -41,8 +41,9 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
                       colors.offsets.back() == static_cast<Index>(pairs.size()),
                   "resolve_contacts: the coloring covers " << colors.items.size() << " items, not the "
                                                            << pairs.size() << " pairs");
+  SHATTER_REQUIRE(dt > 0, "resolve_contacts: step length dt = " << dt << " s");
   SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
-  const DcrLaw law{options.restitution, options.friction, options.gap};
+  const DcrLaw law{options.restitution, options.friction, options.gap, options.mid_step};
 
   // Per-pair accumulators, summed in pair order at the end: the totals do not depend on
   // which thread ran which pair.
@@ -74,7 +75,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
       w[k] = inv_mass[n];
     }
     const auto kind = pair.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
-    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law);
+    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law, 0.5 * dt);
     if (!r.active) return;
     active_now[i] = 1;
     ever_active[i] = 1;

@@ -21,6 +21,7 @@ struct DcrOptions {
   double friction = 0.0;     ///< Coulomb mu >= 0
   double gap = 1e-6;         ///< separation after projection, fraction of the pair's longest edge
   int max_sweeps = 100;      ///< cap on Gauss-Seidel sweeps; reaching it sets DcrResult::capped
+  bool mid_step = false;     ///< collision in the middle of the step (DcrLaw::mid_step)
 };
 
 /// Summary of one call of resolve_contacts.
@@ -48,13 +49,14 @@ void contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, 
 ///   x_new     positions at the end of the step (m), projected in place;
 ///   x_old     positions at the start of the step (m), the motion is linear in between;
 ///   v         velocities (m/s), changed in place by the impulses;
-///   inv_mass  inverse lumped masses (1/kg), 0 for a fixed node (never moved).
+///   inv_mass  inverse lumped masses (1/kg), 0 for a fixed node (never moved);
+///   dt        the step length (s): x_new = x_old + dt v before contact.
 /// Each sweep re-checks every pair (dcr_detect) and resolves the penetrating ones
 /// (dcr_project, dcr_impulse); sweeps repeat until one finds no penetration or
 /// options.max_sweeps is reached. Pairs whose four nodes are not distinct are skipped.
 /// Run inside the caller's tbb::task_arena to choose the thread count.
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std::span<const Vec3> x_old,
-                           std::span<Vec3> v, std::span<const double> inv_mass, const DcrOptions& options,
-                           const DcrPairColors& colors);
+                           std::span<Vec3> v, std::span<const double> inv_mass, double dt,
+                           const DcrOptions& options, const DcrPairColors& colors);
 
 }  // namespace shatter

@@ -13,6 +13,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec) {
   options_.friction = spec.friction;
   options_.max_sweeps = spec.max_sweeps;
   margin_fraction_ = spec.search_margin;
+  options_.mid_step = spec.mid_step;
   rebuild(model.mesh);
 }
 
@@ -51,7 +52,7 @@ void ContactStage::search(std::span<const Vec3> x_old, std::span<const Vec3> x_n
 }
 
 DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                              std::span<const double> inv_mass) {
+                              std::span<const double> inv_mass, double dt) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   if (!candidates_valid(x_old, x_new)) search(x_old, x_new);
@@ -61,7 +62,7 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
   const auto t1 = clock::now();
   contact_pair_nodes(active_, pair_offsets_, pair_nodes_);
   const Coloring colors = greedy_coloring(pair_offsets_, pair_nodes_, static_cast<Index>(x_new.size()));
-  const DcrResult r = resolve_contacts(active_, x_new, x_old, v, inv_mass, options_, {colors.offsets, colors.items});
+  const DcrResult r = resolve_contacts(active_, x_new, x_old, v, inv_mass, dt, options_, {colors.offsets, colors.items});
   const auto t2 = clock::now();
   search_seconds_ += std::chrono::duration<double>(t1 - t0).count();
   dcr_seconds_ += std::chrono::duration<double>(t2 - t1).count();

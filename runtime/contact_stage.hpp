@@ -30,7 +30,7 @@ class ContactStage {
   /// them: x_new is projected back, v (the mid-step velocity) gets the DCR
   /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move.
   DcrResult apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                  std::span<const double> inv_mass);
+                  std::span<const double> inv_mass, double dt);
 
   /// Rebuild the surface after fracture split nodes: crack faces whose sides
   /// no longer share nodes join it, and older triangles get the new node ids.

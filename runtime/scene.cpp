@@ -324,7 +324,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   if (const YAML::Node c = root["contact"]) {
     ContactSpec cs;
     if (!c.IsNull()) {
-      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin"});
+      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin", "placement"});
       if (c["friction"]) {
         cs.friction = r.number(c["friction"], "contact.friction");
         if (cs.friction < 0) r.fail("contact.friction", "a Coulomb coefficient >= 0", c["friction"]);
@@ -338,6 +338,11 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
         cs.search_margin = r.number(c["search_margin"], "contact.search_margin");
         if (!(cs.search_margin >= 0))
           r.fail("contact.search_margin", "a fraction of the median surface edge >= 0", c["search_margin"]);
+      }
+      if (c["placement"]) {
+        const std::string p = r.string(c["placement"], "contact.placement");
+        if (p != "end" && p != "middle") r.fail("contact.placement", "one of end, middle", c["placement"]);
+        cs.mid_step = p == "middle";
       }
     }
     s.contact = cs;

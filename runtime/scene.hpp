@@ -51,6 +51,7 @@ struct ContactSpec {
   double restitution = 1.0;  ///< e in [0, 1]
   int max_sweeps = 100;       ///< cap on DCR Gauss-Seidel sweeps per step (contact.max_sweeps)
   double search_margin = 0.1; ///< candidate reuse margin, fraction of the median surface edge (contact.search_margin)
+  bool mid_step = false;     ///< contact.placement: false = end (of the step), true = middle
 };
 
 struct CheckpointSpec {

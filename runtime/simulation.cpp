@@ -181,7 +181,7 @@ void Simulation::step() {
       const std::span<Vec3> arrays[] = {x_prev_, x_, v_};
       dec_->share(*surface_nodes_, arrays);
     }
-    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_);
+    const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt);
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {

@@ -202,7 +202,7 @@ Coloring color_pairs(const Stack& s) {
 }
 
 DcrResult run(Stack& s, const DcrOptions& options, const Coloring& c) {
-  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, options, {c.offsets, c.items});
+  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, {c.offsets, c.items});
 }
 
 struct Totals {
@@ -355,7 +355,7 @@ TEST(DcrSweep, RejectsInconsistentInput) {
   Stack s = make_stack(2, 2, true, 8);
   const Coloring c = color_pairs(s);
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, {}, {c.offsets, c.items}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {c.offsets, c.items}), Error);
   const std::vector<Index> no_items;
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, {}, {c.offsets, no_items}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {c.offsets, no_items}), Error);
 }

@@ -279,7 +279,7 @@ TEST(DcrProject, NearlyParallelEdgesAreSeparatedNotTilted) {
   PairPoints X = points(Vec3(-1, 0, -0.1), Vec3(1, 0, -0.1), Vec3(-c, -s, 0), Vec3(c, s, 0));
   PairPoints V = Xo - X;
   const PairPoints Xn = X;
-  const DcrPairResponse r = dcr_resolve_pair(EE, Xo, X, V, PairWeights::Ones(), {1.0, 0.0, 1e-6});
+  const DcrPairResponse r = dcr_resolve_pair(EE, Xo, X, V, PairWeights::Ones(), {1.0, 0.0, 1e-6}, 0.5);
   ASSERT_TRUE(r.active);
   EXPECT_TRUE(r.separated);
   const PairPoints dX = X - Xn;
@@ -453,7 +453,7 @@ TEST(DcrResolvePair, FixedNodesNeverMove) {
   PairPoints X = points(Vec3(0.3, 0.3, -0.1), kA, kB, kC);
   PairPoints V = points(Vec3(0.1, 0, -3), Vec3::Zero(), Vec3::Zero(), Vec3::Zero());
   const PairWeights w(1.0, 0, 0, 0);
-  const DcrPairResponse r = dcr_resolve_pair(VF, Xo, X, V, w, {0.5, 0.3, 1e-6});
+  const DcrPairResponse r = dcr_resolve_pair(VF, Xo, X, V, w, {0.5, 0.3, 1e-6}, 0.5);
   EXPECT_TRUE(r.active);
   EXPECT_TRUE(r.separated);
   for (int i = 1; i < 4; ++i) {
@@ -463,6 +463,45 @@ TEST(DcrResolvePair, FixedNodesNeverMove) {
   EXPECT_CLOSE(X(2, 0), 1e-6 * std::sqrt(2.0), 1e-9, 0);   // lifted to the gap
   EXPECT_CLOSE(V(2, 0), 1.5, 1e-14, 0);                     // e = 0.5 bounce
   EXPECT_CLOSE(V(0, 0), 0.0, 0, 1e-15);                     // 0.1 slide stopped by 0.3 x 4.5
+}
+
+// The collision in the middle of the step: a vertex with a random velocity strikes a
+// triangle whose nodes translate together (g is linear in time up to the impulse, which
+// alone separates the pair: no projection). Momenta about the end-of-step configuration
+// and the kinetic energy are kept to round-off, the pair ends clear, and X_new - (dt/2) V
+// is the same mid-step configuration before and after.
+TEST(DcrResolvePair, MidStepImpulseKeepsMomentaAndPlacesTheCollisionAtHalfStep) {
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 0.3);
+  const double dt = 1e-3, half = 0.5 * dt;
+  const DcrLaw law{1.0, 0.0, 1e-6, true};
+  int resolved = 0;
+  double worst_p = 0, worst_L = 0, worst_K = 0, worst_mid = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vec3 face_v(u(rng), u(rng), u(rng));
+    const Vec3 p_old(pos(rng), pos(rng), 0.5 * pos(rng));  // above the face, inside it
+    const Vec3 p_v = face_v + Vec3(u(rng), u(rng), -(1.5 + 0.4 * u(rng)) * p_old.z() / dt);  // crosses in the step
+    PairPoints V = points(p_v, face_v, face_v, face_v);
+    const PairPoints X_old = points(p_old, kA, kB, kC);
+    PairPoints X = X_old + dt * V;
+    const PairWeights w = random_inv_mass(rng);
+    const Ledger before = ledger(X, V, w);  // free flight: the same about X_old and X
+    const PairPoints X_mid = X - half * V;
+    const DcrPairResponse r = dcr_resolve_pair(VF, X_old, X, V, w, law, half);
+    if (!r.active) continue;
+    ++resolved;
+    ASSERT_TRUE(r.separated);
+    const Ledger after = ledger(X, V, w);
+    worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
+    worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
+    worst_K = std::max(worst_K, std::abs(after.kinetic - before.kinetic) / before.kinetic);
+    worst_mid = std::max(worst_mid, (X - half * V - X_mid).norm() / X_mid.norm());
+  }
+  EXPECT_GT(resolved, 280);
+  EXPECT_LT(worst_p, 1e-13);
+  EXPECT_LT(worst_L, 1e-13);
+  EXPECT_LT(worst_K, 1e-13);
+  EXPECT_LT(worst_mid, 1e-14);
 }
 
 TEST(DcrResolvePair, RandomMultiPairImpactsConserveMomenta) {

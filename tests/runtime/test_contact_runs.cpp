@@ -43,45 +43,51 @@ const char* kSteel = "  steel: {model: neo_hookean, density: 7850, youngs_modulu
 // exactly one-dimensional, the bar speed sqrt(E / rho) is the dilatational speed), bar 0
 // at v, bar 1 at rest. Elastic impact of equal bars: the contact lasts 2 L / c, then bar 0
 // is at rest and bar 1 moves at v. Small v keeps the strain (v / 2c = 1e-4) linear.
+// For both collision placements (contact.placement): the issue's 1 % on the total energy
+// holds for `middle` (+0.02 % measured); `end` ([CW]'s placement) loses 1.29 %
+// (docs/contact.md), held to 2 % so that it cannot get worse unnoticed.
 TEST(ContactRuns, EqualBarsHeadOnLast2LOverCAndExchangeVelocities) {
   const double len = 0.05, w = 0.005, v = 1.0, gap = 2e-6;
   const double E = 210.0e9, rho = 7850;
   const std::string x0 = std::to_string(-0.5 * len - 0.5 * gap), x1 = std::to_string(0.5 * len + 0.5 * gap);
   const std::string bar = "shape: box, size: [" + std::to_string(len) + ", " + std::to_string(w) + ", " +
                           std::to_string(w) + "], element_size: 0.0025, order: 1";
-  Model m = build_model(scene_from_text(
-      "bars", "name: bars\ntime: {end: 1.0}\nmaterials:\n"
-              "  m0: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.0}\n"
-              "bodies:\n"
-              "  - {name: a, material: m0, mesh: {" + bar + ", center: [" + x0 + ", 0, 0]}, initial_velocity: [1.0, 0, 0]}\n"
-              "  - {name: b, material: m0, mesh: {" + bar + ", center: [" + x1 + ", 0, 0]}}\n"
-              "contact: {friction: 0.0, restitution: 1.0}\n"));
-  Simulation sim(m, {});
-  const double c = std::sqrt(E / rho), duration = 2 * len / c;
-  const Ledger l0 = sim.ledger();
-  double t_first = -1, t_last = -1, dp_max = 0;
-  int penetrations = 0;
-  while (sim.time() < gap / v + 1.6 * duration) {
-    sim.step();
-    if (sim.ledger().contacts > 0) {
-      if (t_first < 0) t_first = sim.time();
-      t_last = sim.time();
+  for (const auto& [placement, energy_bound] : {std::pair{"middle", 0.01}, std::pair{"end", 0.02}}) {
+    SCOPED_TRACE(placement);
+    Model m = build_model(scene_from_text(
+        "bars", "name: bars\ntime: {end: 1.0}\nmaterials:\n"
+                "  m0: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.0}\n"
+                "bodies:\n"
+                "  - {name: a, material: m0, mesh: {" + bar + ", center: [" + x0 + ", 0, 0]}, initial_velocity: [1.0, 0, 0]}\n"
+                "  - {name: b, material: m0, mesh: {" + bar + ", center: [" + x1 + ", 0, 0]}}\n"
+                "contact: {friction: 0.0, restitution: 1.0, placement: " + placement + "}\n"));
+    Simulation sim(m, {});
+    const double c = std::sqrt(E / rho), duration = 2 * len / c;
+    const Ledger l0 = sim.ledger();
+    double t_first = -1, t_last = -1, dp_max = 0;
+    int penetrations = 0;
+    while (sim.time() < gap / v + 1.6 * duration) {
+      sim.step();
+      if (sim.ledger().contacts > 0) {
+        if (t_first < 0) t_first = sim.time();
+        t_last = sim.time();
+      }
+      dp_max = std::max(dp_max, (sim.ledger().momentum - l0.momentum).norm());
+      penetrations += count_penetrations(sim);
     }
-    dp_max = std::max(dp_max, (sim.ledger().momentum - l0.momentum).norm());
-    penetrations += count_penetrations(sim);
+    ASSERT_GT(t_first, 0.0) << "the bars never touched";
+    EXPECT_CLOSE(t_last - t_first, duration, 0.05, 0) << "contact from " << t_first << " to " << t_last << " s";
+    EXPECT_NEAR(body_velocity(sim, 0).x(), 0.0, 0.05 * v);
+    EXPECT_CLOSE(body_velocity(sim, 1).x(), v, 0.05, 0);
+    std::printf("bars (%s): contact %.4e s (2L/c %.4e), v_a %.4f v_b %.4f of v, energy %+.3e\n", placement,
+                t_last - t_first, duration, body_velocity(sim, 0).x() / v, body_velocity(sim, 1).x() / v,
+                sim.ledger().total() / l0.total() - 1);
+    EXPECT_EQ(sim.ledger().contact_dissipated, 0.0);
+    EXPECT_CLOSE(sim.ledger().total(), l0.total(), energy_bound, 0);
+    EXPECT_LT(dp_max, 1e-12 * l0.momentum.norm());
+    EXPECT_EQ(penetrations, 0);
+    EXPECT_EQ(sim.ledger().contact_capped_steps, 0);
   }
-  ASSERT_GT(t_first, 0.0) << "the bars never touched";
-  EXPECT_CLOSE(t_last - t_first, duration, 0.05, 0) << "contact from " << t_first << " to " << t_last << " s";
-  EXPECT_NEAR(body_velocity(sim, 0).x(), 0.0, 0.05 * v);
-  EXPECT_CLOSE(body_velocity(sim, 1).x(), v, 0.05, 0);
-  std::printf("bars: contact %.4e s (2L/c %.4e), v_a %.4f v_b %.4f of v, energy %+.3e\n", t_last - t_first, duration,
-              body_velocity(sim, 0).x() / v, body_velocity(sim, 1).x() / v, sim.ledger().total() / l0.total() - 1);
-  // Target 1 %; the end-of-step projection loses about t* dt v_n f_n per impact (1.3 % here,
-  // docs/contact.md), so the bound guards the present state.
-  EXPECT_CLOSE(sim.ledger().total(), l0.total(), 0.02, 0);
-  EXPECT_LT(dp_max, 1e-12 * l0.momentum.norm());
-  EXPECT_EQ(penetrations, 0);
-  EXPECT_EQ(sim.ledger().contact_capped_steps, 0);
 }
 
 namespace {
