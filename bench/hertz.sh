@@ -13,7 +13,8 @@
 # hertz_metrics in bench/speed_accuracy/speed_accuracy.py.
 # Run:     bash bench/hertz.sh BUILD_DIR [V] [sizes...]   (default V = 50 m/s,
 #          sizes 1.0e-3 8.0e-4 6.0e-4 m)
-# Output:  bench/results/hertz.csv and a table on stdout.
+#          PLACEMENT=middle for contact.placement: middle (default end).
+# Output:  bench/results/hertz.csv (hertz_middle.csv) and a table on stdout.
 # Expect:  durations 5-12 % short of t_c and peak forces within 20 % at these
 #          sizes (the contact patch, radius ~0.8 mm at 50 m/s, spans one or
 #          two elements; docs/contact.md); about 2 minutes in all.
@@ -23,6 +24,9 @@ shift
 speed=${1:-50}
 [ $# -gt 0 ] && shift
 sizes=("$@")
+placement=${PLACEMENT:-end}
+suffix=$([ "$placement" = end ] && echo "" || echo "_$placement")
+csv_out="$out/hertz$suffix.csv"
 [ ${#sizes[@]} -eq 0 ] && sizes=(1.0e-3 8.0e-4 6.0e-4)
 here=$(cd "$(dirname "$0")" && pwd)
 out="$here/results"
@@ -32,13 +36,14 @@ trap 'rm -rf "$work"' EXIT
 
 half=$(python3 -c "print($speed / 2)")
 
-echo "h,elements,steps,t_contact,t_hertz,duration_error,f_peak,f_hertz,force_error,energy_error,wall_time" > "$out/hertz.csv"
+echo "h,elements,steps,t_contact,t_hertz,duration_error,f_peak,f_hertz,force_error,energy_error,wall_time" > "$csv_out"
 for h in "${sizes[@]}"; do
   dir="$work/h$h"
   "$build/apps/shatter" run "$here/speed_accuracy/hertz_spheres.yaml" --out "$dir" --threads 1 --quiet \
     --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h" \
-    --set "bodies[0].initial_velocity=[$half,0,0]" --set "bodies[1].initial_velocity=[-$half,0,0]"
-  /usr/bin/python3 - "$dir" "$h" "$speed" "$here/speed_accuracy" >> "$out/hertz.csv" <<'EOF'
+    --set "bodies[0].initial_velocity=[$half,0,0]" --set "bodies[1].initial_velocity=[-$half,0,0]" \
+    --set "contact.placement=$placement"
+  /usr/bin/python3 - "$dir" "$h" "$speed" "$here/speed_accuracy" >> "$csv_out" <<'EOF'
 import json, sys
 d, h, v = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
 sys.path.insert(0, sys.argv[4])
@@ -48,6 +53,6 @@ m = hertz_metrics(d, h, v)
 print(f"{h},{s['elements']},{s['steps']},{m['t_contact']:.6e},{m['t_hertz']:.6e},{m['duration_error']:+.4f},"
       f"{m['f_peak']:.6e},{m['f_hertz']:.6e},{m['force_error']:+.4f},{s['energy_error']:+.3e},{s['wall_time']:.1f}")
 EOF
-  tail -1 "$out/hertz.csv"
+  tail -1 "$csv_out"
 done
-column -s, -t "$out/hertz.csv"
+column -s, -t "$csv_out"
