@@ -26,11 +26,11 @@ speed=${1:-50}
 sizes=("$@")
 placement=${PLACEMENT:-end}
 suffix=$([ "$placement" = end ] && echo "" || echo "_$placement")
-csv_out="$out/hertz$suffix.csv"
 [ ${#sizes[@]} -eq 0 ] && sizes=(1.0e-3 8.0e-4 6.0e-4)
 here=$(cd "$(dirname "$0")" && pwd)
 out="$here/results"
 mkdir -p "$out"
+csv_out="$out/hertz$suffix.csv"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
