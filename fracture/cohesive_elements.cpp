@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "kernels/error.hpp"
 
@@ -146,6 +147,48 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
     }
   }
   return total;
+}
+
+double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
+                                 const CohesiveElements& coh, FractureLaws laws,
+                                 std::span<const double> mass) {
+  const int k = mesh.order == 1 ? 3 : 6;
+  // Per facet node j: sum_q (1/3) |N_j(x_q)| sum_l |N_l(x_q)|, times the area.
+  std::array<double, 6> row{};
+  for (const Vec3& p : facet_points()) {
+    const std::array<double, 6> N = facet_shape(p, k);
+    double sum_abs = 0;
+    for (int l = 0; l < k; ++l) sum_abs += std::abs(N[l]);
+    for (int j = 0; j < k; ++j) row[j] += std::abs(N[j]) * sum_abs / kCohesivePoints;
+  }
+  std::vector<double> stiffness(mass.size(), 0.0);  // Gershgorin row sums, N/m
+  for (Index c = 0; c < coh.size(); ++c) {
+    if (topo.facet_state[coh.facet[c]] != FacetState::cohesive) continue;
+    const double kc = 2.0 * cohesive_stiffness_bound(*facet_law(mesh, topo, laws, coh.facet[c]));
+    const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+    for (int s = 0; s < 2; ++s)
+      for (int j = 0; j < k; ++j) stiffness[nodes[s * kSlots + j]] += kc * coh.area[c] * row[j];
+  }
+  double bound = 0;
+  for (size_t i = 0; i < mass.size(); ++i)
+    if (stiffness[i] > 0) bound = std::max(bound, stiffness[i] / mass[i]);
+  return bound;
+}
+
+std::vector<double> element_damage(const Mesh& mesh, const Topology& topo,
+                                   const CohesiveElements& coh, FractureLaws laws) {
+  std::vector<double> damage(mesh.num_elements(), 0.0);
+  for (Index c = 0; c < coh.size(); ++c) {
+    const Index f = coh.facet[c];
+    double d = 1.0;
+    if (topo.facet_state[f] == FacetState::cohesive) {
+      const double* dm = coh.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+      d = std::min(1.0, *std::max_element(dm, dm + kCohesivePoints) /
+                            facet_law(mesh, topo, laws, f)->delta_c);
+    }
+    for (const Index e : topo.facet_elem[f]) damage[e] = std::max(damage[e], d);
+  }
+  return damage;
 }
 
 Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,

@@ -88,6 +88,28 @@ struct CohesiveEnergy {
 CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& cohesive,
                                FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int);
 
+/// Upper bound of the largest eigenvalue of M^-1 K_c, 1/s^2, where K_c is the
+/// stiffness of the cohesive forces (facets in state `cohesive`) and M the
+/// lumped masses `mass` (kg, per node). Each traction stiffness is at most
+/// cohesive_stiffness_bound(law) = k (Pa/m), so by Gershgorin's theorem the
+/// bound is max over nodes i of (1 / m_i) sum over its cohesive slots of
+///   2 k sum_q w_q |N_i(x_q)| sum_l |N_l(x_q)|
+/// (the factor 2: both sides of the facet; 2 k A / 3 per TET4 corner).
+/// Since the eigenvalues of M^-1 (K_e + K_c) are at most the sum of the two
+/// bounds, a step 2 / sqrt(omega_e^2 + this) is stable for the volume
+/// elements (omega_e = 2 / stable dt of the elements) and the cohesive
+/// elements together. 0 when there is no cohesive element.
+double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
+                                 const CohesiveElements& cohesive, FractureLaws laws,
+                                 std::span<const double> mass);
+
+/// Damage of every element, in [0, 1], for output: the largest over its
+/// facets of min(1, delta_max / delta_c) (largest over the facet's points)
+/// for a cohesive facet, 1 for a freed crack facet, 0 for intact facets and
+/// the outer boundary. Layout [e].
+std::vector<double> element_damage(const Mesh& mesh, const Topology& topo,
+                                   const CohesiveElements& cohesive, FractureLaws laws);
+
 /// Mark free the cohesive facets whose every quadrature point has opened past
 /// delta_c (no traction left; the two sides now belong to separate fragments
 /// unless joined elsewhere). Returns the number of facets freed.

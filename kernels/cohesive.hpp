@@ -10,14 +10,30 @@
 // the traction (Pa) derives from a potential phi(delta, delta_max):
 //   T = (t / delta) (beta^2 delta_s + delta_n n),
 // so that T . dDelta = t d(delta) along any path. The effective traction is
-//   loading   (delta >= delta_max): t = sigma_c (1 - delta / delta_c), 0 past delta_c
-//   unloading (delta <  delta_max): t = t(delta_max) / delta_max * delta  (secant to 0)
-// with delta_c = 2 Gc / sigma_c, so that the work of separation is Gc (J/m^2)
-// for every mode mixity. The state is the largest effective opening reached.
+//   loading   (delta >= delta_max): t = envelope(delta)
+//   unloading (delta <  delta_max): t = envelope(delta_max) / delta_max * delta
+//                                   (secant to the origin)
+// with the envelope
+//   t = k_p delta                                 for delta <= delta_0,
+//   t = sigma_c (delta_c - delta) / (delta_c - delta_0)  up to delta_c, 0 past it,
+// delta_c = 2 Gc / sigma_c and delta_0 = sigma_c / k_p. The work of separation
+// is the area of this triangle, sigma_c delta_c / 2 = Gc (J/m^2), for every
+// mode mixity. The state is the largest effective opening reached.
+//
+// The short elastic rise to sigma_c (delta_0 / delta_c = sigma_c^2 / (2 Gc
+// k_p), 2 % on the fine expanding ring and 4 % on the coarse one) replaces the rigid start of the purely
+// extrinsic law, whose secant sigma_c / delta_max is unbounded as
+// delta_max -> 0: a facet that recloses just after insertion then acts as an
+// arbitrarily stiff spring on its nodes, which no time step integrates stably
+// (docs/validation.md, the late blow-up of the fine ring). With the rise,
+// every stiffness of the law (secant, the loading branch's transverse part
+// t / delta, the compression penalty) is at most max(1, beta^2) k_p
+// (cohesive_stiffness_bound), which the stable step includes. Insertion stays
+// extrinsic: the facet is rigid until the criterion breaks it.
 //
 // Compression (delta_n < 0): the cohesive law acts on the shear part only
 // (delta = beta |delta_s|) and interpenetration is resisted by a linear normal
-// penalty T_n = k_p delta_n n with a user stiffness k_p (Pa/m), e.g. E / h.
+// penalty T_n = k_p delta_n n with the same stiffness k_p (Pa/m), e.g. E / h.
 // This is a choice of this code: contact (DCR) will also act on crack faces
 // once they are in the contact surface, the penalty only keeps the two sides
 // of a closed crack apart between contact sweeps.
@@ -25,12 +41,14 @@
 // Energies per unit reference area (J/m^2):
 //   stored     = 1/2 (t(delta_max) / delta_max) delta^2 + 1/2 k_p <-delta_n>^2
 //                (recoverable: the area under the secant, plus the penalty)
-//   dissipated = W(delta_max) - 1/2 t(delta_max) delta_max = sigma_c delta_max / 2,
-//                capped at Gc once delta_max >= delta_c,
-// where W(delta_max) is the area under the loading curve up to delta_max.
+//   dissipated = W(delta_max) - 1/2 t(delta_max) delta_max
+//              = (sigma_c delta_max - t(delta_max) delta_0) / 2 past delta_0
+//                (0 on the elastic rise), Gc once delta_max >= delta_c,
+// where W(delta_max) is the area under the envelope up to delta_max.
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/error.hpp"
 #include "kernels/types.hpp"
 
 namespace shatter {
@@ -40,21 +58,46 @@ struct CohesiveLaw {
   double sigma_c = 0;  ///< cohesive strength, Pa
   double delta_c = 0;  ///< critical effective opening 2 Gc / sigma_c, m
   double beta = 1;     ///< shear-to-normal weighting, dimensionless
-  double penalty = 0;  ///< normal stiffness in compression k_p, Pa/m
+  double penalty = 0;  ///< k_p, Pa/m: slope of the elastic rise and normal stiffness in compression
 
   /// Fracture energy Gc = sigma_c delta_c / 2, J/m^2.
   double fracture_energy() const { return 0.5 * sigma_c * delta_c; }
+  /// End of the elastic rise, delta_0 = sigma_c / k_p, m.
+  double delta_0() const { return sigma_c / penalty; }
 };
 
-/// sigma_c (Pa), Gc (J/m^2), beta (-), penalty k_p (Pa/m).
+/// sigma_c (Pa), Gc (J/m^2), beta (-), penalty k_p (Pa/m). Requires
+/// delta_0 = sigma_c / k_p < delta_c = 2 Gc / sigma_c.
 inline CohesiveLaw make_cohesive_law(double sigma_c, double fracture_energy, double beta,
                                      double penalty) {
-  return {sigma_c, 2.0 * fracture_energy / sigma_c, beta, penalty};
+  const CohesiveLaw law{sigma_c, 2.0 * fracture_energy / sigma_c, beta, penalty};
+  SHATTER_REQUIRE(law.delta_0() < law.delta_c,
+                  "cohesive law: the elastic rise sigma_c / k_p = "
+                      << law.delta_0() << " m must end before delta_c = 2 Gc / sigma_c = "
+                      << law.delta_c << " m (raise Gc or the penalty k_p)");
+  return law;
 }
 
-/// Effective traction on the loading envelope, t = sigma_c <1 - delta/delta_c>, Pa.
+/// Effective traction on the loading envelope, Pa: k_p delta up to delta_0,
+/// then sigma_c (delta_c - delta) / (delta_c - delta_0), 0 past delta_c.
 inline double cohesive_envelope(const CohesiveLaw& law, double delta) {
-  return law.sigma_c * std::max(0.0, 1.0 - delta / law.delta_c);
+  const double d0 = law.delta_0();
+  if (delta <= d0) return law.penalty * delta;
+  return law.sigma_c * std::max(0.0, (law.delta_c - delta) / (law.delta_c - d0));
+}
+
+/// Secant t(delta) / delta of the envelope, Pa/m: k_p on the elastic rise
+/// (also the limit at delta = 0), so never above k_p.
+inline double cohesive_secant(const CohesiveLaw& law, double delta) {
+  return delta <= law.delta_0() ? law.penalty : cohesive_envelope(law, delta) / delta;
+}
+
+/// Upper bound of the norm of dT/dDelta over every state and opening, Pa/m:
+/// max(1, beta^2) k_p (secants, the loading branch's transverse stiffness
+/// t / delta and the compression penalty are all at most this; the loading
+/// branch's own slope is -sigma_c / (delta_c - delta_0), smaller in size).
+inline double cohesive_stiffness_bound(const CohesiveLaw& law) {
+  return std::max(1.0, law.beta * law.beta) * law.penalty;
 }
 
 /// Result of one evaluation of the law at one point of a cohesive surface.
@@ -77,22 +120,19 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   const double delta = std::sqrt(beta2 * delta_s.squaredNorm() + open_n * open_n);
 
   CohesiveTraction out;
-  double t_over_delta = 0;  // secant t / delta, Pa/m
-  if (delta >= delta_max) {
-    out.delta_max = delta;
-    if (delta > 0) t_over_delta = cohesive_envelope(law, delta) / delta;
-  } else {
-    out.delta_max = delta_max;
-    t_over_delta = cohesive_envelope(law, delta_max) / delta_max;
-  }
+  out.delta_max = std::max(delta, delta_max);
+  const double t_over_delta = cohesive_secant(law, out.delta_max);  // Pa/m
   out.traction = t_over_delta * (beta2 * delta_s + open_n * n);
   out.stored = 0.5 * t_over_delta * delta * delta;
   if (delta_n < 0) {
     out.traction += law.penalty * delta_n * n;
     out.stored += 0.5 * law.penalty * delta_n * delta_n;
   }
-  out.dissipated =
-      out.delta_max >= law.delta_c ? law.fracture_energy() : 0.5 * law.sigma_c * out.delta_max;
+  const double dm = out.delta_max;
+  out.dissipated = dm >= law.delta_c ? law.fracture_energy()
+                   : dm <= law.delta_0()
+                       ? 0.0
+                       : 0.5 * (law.sigma_c * dm - cohesive_envelope(law, dm) * law.delta_0());
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "fracture/facet_criterion.hpp"
 #include "kernels/tet4.hpp"
@@ -54,6 +55,17 @@ std::vector<Index> FractureStage::cohesive_nodes() const {
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   return nodes;
+}
+
+double FractureStage::stable_dt(double element_dt, std::span<const double> mass) {
+  if (cohesive_.size() == 0) return element_dt;
+  const std::array<Index, 2> key = {cohesive_.size(), model_.mesh.num_nodes()};
+  if (key != bound_key_) {
+    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws_, mass);
+    bound_key_ = key;
+  }
+  const double omega_e = 2.0 / element_dt;
+  return 2.0 / std::sqrt(omega_e * omega_e + eigenvalue_bound_);
 }
 
 Index FractureStage::release() {

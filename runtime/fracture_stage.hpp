@@ -2,6 +2,7 @@
 // Step 5 of the time loop (DESIGN.md): the facet check, extrinsic insertion
 // of cohesive elements with node splitting, cohesive forces and fragments,
 // for scenes with a material that has a fracture block.
+#include <array>
 #include <optional>
 #include <span>
 #include <vector>
@@ -14,10 +15,10 @@ namespace shatter {
 
 class FractureStage {
  public:
-  /// The compression penalty of each material's cohesive law is
-  /// k_p = E / h_min (h_min: smallest element altitude of that material), as
-  /// stiff as the adjacent elements, so it keeps crack faces from
-  /// interpenetrating without shrinking the stable step.
+  /// The penalty of each material's cohesive law (slope of the elastic rise
+  /// and normal stiffness in compression) is k_p = E / h_min (h_min: smallest
+  /// element altitude of that material), as stiff as the adjacent elements;
+  /// stable_dt() accounts for it.
   explicit FractureStage(Model& model);
 
   /// Adds cohesive forces dE/dx at positions x to f_int; returns the energies.
@@ -36,6 +37,12 @@ class FractureStage {
   /// The facet of each cohesive element.
   std::span<const Index> cohesive_facets() const { return cohesive_.facet; }
 
+  /// Stable step of the volume and cohesive elements together, s (no safety
+  /// factor): 2 / sqrt((2 / element_dt)^2 + lambda_c), lambda_c the bound of
+  /// cohesive_eigenvalue_bound for the lumped masses `mass` (kg, per node),
+  /// recomputed when cohesive elements or nodes were added since the last call.
+  double stable_dt(double element_dt, std::span<const double> mass);
+
   /// Frees fully debonded facets; returns how many.
   Index release();
 
@@ -43,6 +50,8 @@ class FractureStage {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
   Index cohesive_count() const { return cohesive_.size(); }
+  /// Per element damage in [0, 1] (element_damage), for output.
+  std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws_); }
   double check_seconds() const { return check_seconds_; }
 
  private:
@@ -51,6 +60,8 @@ class FractureStage {
   CohesiveElements cohesive_;
   std::vector<std::optional<CohesiveLaw>> laws_;
   double check_seconds_ = 0;
+  double eigenvalue_bound_ = 0;                   ///< cached cohesive bound, 1/s^2
+  std::array<Index, 2> bound_key_ = {-1, -1};     ///< (cohesive count, node count) it was computed for
 };
 
 }  // namespace shatter

@@ -108,7 +108,9 @@ void Simulation::compute_forces() {
     ledger_.cohesive_stored = ce.stored;
     ledger_.cohesive_dissipated = ce.dissipated;
   }
-  stable_dt_ = dec_->min(last_elements_.stable_dt);
+  // With cohesive elements the stable step also bounds their stiffness.
+  stable_dt_ = dec_->min(fracture_ ? fracture_->stable_dt(last_elements_.stable_dt, model_.mass)
+                                   : last_elements_.stable_dt);
   if (dec_->distributed()) {
     // The worst element over all ranks (NaN first, then the smallest det F,
     // then the smallest index, as on one rank).
@@ -456,6 +458,7 @@ void Simulation::write_outputs(bool fields) {
     Mesh empty;
     empty.order = mesh.order;
     std::vector<int> fragment_id;
+    std::vector<double> damage;
     if (root) {
       element_stresses(model_, xv[0], stress, vm);
       u.resize(mesh.num_nodes());
@@ -468,6 +471,8 @@ void Simulation::write_outputs(bool fields) {
       if (frags) {
         fragment_id.assign(frags->elem_fragment.begin(), frags->elem_fragment.end());
         f.fragment = fragment_id;
+        damage = fracture_->damage();
+        f.damage = damage;
       }
     }
     fields_->write(root ? mesh : empty, f);

@@ -3,6 +3,7 @@
 // release -> fragments), with the energy dissipated checked against Gc x area.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -226,7 +227,7 @@ TEST(CohesiveForces, Tet10UniformOpeningLoadsOnlyMidEdgeNodes) {
   for (int j = 0; j < 6; ++j) x[coh.side_nodes[6 + j]] += 0.25 * law.delta_c * Vec3(0, 0, -1);
   std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
   cohesive_forces(m, t, coh, test::one_law(law), x, f);
-  const double t_eff = law.sigma_c * 0.75, area = 0.5;
+  const double t_eff = cohesive_envelope(law, 0.25 * law.delta_c), area = 0.5;
   for (int j = 0; j < 6; ++j) {
     const Vec3 expected = j < 3 ? Vec3::Zero() : Vec3(0, 0, -t_eff * area / 3);
     EXPECT_LT((f[coh.side_nodes[6 + j]] - expected).norm(), 1e-12 * t_eff * area);
@@ -259,4 +260,53 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
     EXPECT_GT(scale, 0.0);
     EXPECT_LT(sum.norm(), 1e-14 * scale);
   }
+}
+
+TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
+  // The stiffness K of the cohesive forces by central differences on two
+  // elements joined by one cohesive facet, opened a little (on the elastic
+  // rise, in tension and in compression): the largest eigenvalue of
+  // M^-1/2 K M^-1/2 stays below cohesive_eigenvalue_bound, which the stable
+  // step adds to the elements' omega^2, and the bound is not loose.
+  for (const Mesh& start : {two_tets(), two_tet10s()})
+    for (double beta : {0.6, 1.0, 1.5})
+      for (double sign : {1.0, -1.0}) {
+        Mesh m = start;
+        Topology t = build_topology(m);
+        CohesiveElements coh;
+        const CohesiveLaw law = make_cohesive_law(100.0, 1.0, beta, 1.0e7);
+        const auto laws = test::one_law(law);
+        insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
+        const std::vector<double> mass = test::lumped_masses(m, 1000.0);
+        const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
+        // Open side 1 by a fraction of delta_0 along a mixed direction.
+        std::vector<Vec3> x = m.reference;
+        const int k = m.order == 1 ? 3 : 6;
+        for (int j = 0; j < k; ++j)
+          x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
+        const Index ndof = 3 * m.num_nodes();
+        Eigen::MatrixXd K(ndof, ndof);
+        const double h = 1e-4 * law.delta_0();
+        for (Index d = 0; d < ndof; ++d) {
+          std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
+                            fm(m.num_nodes(), Vec3::Zero());
+          xp[d / 3][d % 3] += h;
+          xm[d / 3][d % 3] -= h;
+          CohesiveElements cp = coh, cm = coh;
+          cohesive_forces(m, t, cp, laws, xp, fp);
+          cohesive_forces(m, t, cm, laws, xm, fm);
+          for (Index r = 0; r < ndof; ++r)
+            K(r, d) = (fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h) /
+                      std::sqrt(mass[r / 3] * mass[d / 3]);
+        }
+        const Eigen::MatrixXd S = 0.5 * (K + K.transpose());
+        const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S)
+                                   .eigenvalues()
+                                   .cwiseAbs()
+                                   .maxCoeff();
+        SCOPED_TRACE(testing::Message() << "order " << m.order << " beta " << beta << " sign "
+                                        << sign << ": largest " << largest << ", bound " << bound);
+        EXPECT_LE(largest, bound * (1 + 1e-6));
+        EXPECT_GE(largest, 0.25 * bound);
+      }
 }
