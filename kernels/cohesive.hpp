@@ -25,7 +25,8 @@
 // extrinsic law, whose secant sigma_c / delta_max is unbounded as
 // delta_max -> 0: a facet that recloses just after insertion then acts as an
 // arbitrarily stiff spring on its nodes, which no time step integrates stably
-// (docs/validation.md, the late blow-up of the fine ring). With the rise,
+// (measured 10-100 x beyond the limit on the fine ring, docs/validation.md).
+// With the rise,
 // every stiffness of the law (secant, the loading branch's transverse part
 // t / delta, the compression penalty) is at most max(1, beta^2) k_p
 // (cohesive_stiffness_bound), which the stable step includes. Insertion stays

@@ -103,7 +103,20 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
   const Vec3 axis = s.axis.normalized();
   if (s.shape == "box") {
     const Vec3 lo = s.center - 0.5 * s.size;
-    gmsh::model::occ::addBox(lo.x(), lo.y(), lo.z(), s.size.x(), s.size.y(), s.size.z());
+    const int box = gmsh::model::occ::addBox(lo.x(), lo.y(), lo.z(), s.size.x(), s.size.y(), s.size.z());
+    if (s.notch_size.squaredNorm() > 0) {
+      const Vec3 nlo = s.notch_center - 0.5 * s.notch_size;
+      const int notch = gmsh::model::occ::addBox(nlo.x(), nlo.y(), nlo.z(), s.notch_size.x(), s.notch_size.y(),
+                                                 s.notch_size.z());
+      gmsh::vectorpair out;
+      std::vector<gmsh::vectorpair> map;
+      gmsh::model::occ::cut({{3, box}}, {{3, notch}}, out, map);
+      const double volume = s.size.prod();
+      double mass = 0;
+      if (out.size() == 1) gmsh::model::occ::getMass(3, out[0].second, mass);
+      if (out.size() != 1 || !(mass < volume * (1 - 1e-12)))
+        throw InputError(where + ".notch: expected a box that cuts into the body and leaves it in one piece");
+    }
   } else if (s.shape == "cylinder") {
     const Vec3 base = s.center - 0.5 * s.length * axis;
     const Vec3 d = s.length * axis;

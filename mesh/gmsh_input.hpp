@@ -18,6 +18,10 @@ struct ShapeSpec {
   Vec3 center = Vec3::Zero();      ///< centre of the shape
   Vec3 axis = Vec3(0, 0, 1);       ///< cylinder/tube axis
   double element_size = 0;         ///< target edge length
+  /// box only: a box (centre, edge lengths) cut out of it, e.g. a saw-cut
+  /// notch reaching a face; notch_size zero = none
+  Vec3 notch_center = Vec3::Zero();
+  Vec3 notch_size = Vec3::Zero();
   int order = 1;                   ///< 1 = TET4, 2 = TET10
 };
 

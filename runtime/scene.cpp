@@ -136,9 +136,17 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
   ShapeSpec s;
   s.shape = r.string(r.required(m, key, "shape"), key + ".shape");
   if (s.shape == "box") {
-    r.only_keys(m, key, {"shape", "size", "center", "element_size", "order"});
+    r.only_keys(m, key, {"shape", "size", "center", "element_size", "order", "notch"});
     s.size = r.vec3(r.required(m, key, "size"), key + ".size");
     if ((s.size.array() <= 0).any()) r.fail(key + ".size", "three positive lengths", m["size"]);
+    if (const YAML::Node n = m["notch"]) {
+      const std::string nk = key + ".notch";
+      if (!n.IsMap()) r.fail(nk, "a map with center and size", n);
+      r.only_keys(n, nk, {"center", "size"});
+      s.notch_center = r.vec3(r.required(n, nk, "center"), nk + ".center");
+      s.notch_size = r.vec3(r.required(n, nk, "size"), nk + ".size");
+      if ((s.notch_size.array() <= 0).any()) r.fail(nk + ".size", "three positive lengths", n["size"]);
+    }
   } else if (s.shape == "cylinder" || s.shape == "sphere") {
     if (s.shape == "cylinder")
       r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size", "order"});

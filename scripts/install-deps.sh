@@ -8,7 +8,7 @@ packages=(
   libtbb-dev libeigen3-dev libmetis-dev libhdf5-openmpi-dev
   libgmsh-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtrilinos-zoltan-dev libcgal-dev
-  python3-matplotlib python3-numpy
+  python3-matplotlib python3-numpy python3-h5py
 )
 missing=()
 for p in "${packages[@]}"; do

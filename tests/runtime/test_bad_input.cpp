@@ -87,6 +87,12 @@ TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {
        {"time.fracture_check_every", "integer >= 1"}},
       {"placement_unknown", kGood + "contact: {placement: start}\n", {"contact.placement", "one of end, middle"}},
       {"invalid_yaml", kGood + "time: [\n", {"not valid YAML"}},
+      {"notch_outside_the_box",
+       replaced(kGood, "element_size: 0.005}", "element_size: 0.005, notch: {center: [1, 0, 0], size: [0.002, 0.002, 0.02]}}"),
+       {"bodies[0].mesh.notch", "cuts into the body"}},
+      {"notch_zero_size",
+       replaced(kGood, "element_size: 0.005}", "element_size: 0.005, notch: {center: [0, 0, 0], size: [0, 0.002, 0.02]}}"),
+       {"bodies[0].mesh.notch.size", "three positive lengths"}},
   };
   for (const Case& c : cases) {
     const std::string path = shatter::test::write_scene(std::string("bad_") + c.name, c.yaml);
