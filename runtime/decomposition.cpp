@@ -164,6 +164,13 @@ void Decomposition::update_ghost_only(std::span<Vec3> x) {
 
 std::size_t Decomposition::ghost_bytes() const { return halo_ ? halo_->update_bytes(3) : 0; }
 
+DecompositionStats Decomposition::stats() const {
+  long v[5] = {-owned_elements_, owned_elements_, static_cast<long>(local_elements_.size()),
+               static_cast<long>(ghost_bytes()), halo_ ? halo_->update_messages() : 0};
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, v, 5, MPI_LONG, MPI_MAX, comm_);
+  return {-v[0], v[1], v[2], v[3], v[4]};
+}
+
 SharedNodes Decomposition::shared_nodes(std::vector<Index> nodes) const {
   SharedNodes s;
   s.nodes = std::move(nodes);

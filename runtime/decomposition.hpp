@@ -39,6 +39,14 @@ namespace shatter {
 
 class Halo;
 
+/// Load balance and message volume of a decomposition (summary.json).
+struct DecompositionStats {
+  long owned_min = 0, owned_max = 0;  ///< owned elements per rank
+  long local_max = 0;                 ///< owned + ghost elements per rank
+  long ghost_bytes_max = 0;           ///< bytes one rank sends per ghost update
+  long ghost_messages_max = 0;        ///< messages one rank sends per ghost update
+};
+
 /// A subset of the nodes, listed identically on every rank (ascending), whose
 /// owners' values are shared with every rank (Decomposition::share).
 struct SharedNodes {
@@ -92,6 +100,8 @@ class Decomposition {
   void update_ghost_only(std::span<Vec3> x);
   /// Bytes this rank sends per update_ghost_only.
   std::size_t ghost_bytes() const;
+  /// Over all ranks (collective).
+  DecompositionStats stats() const;
 
   /// The plan of share() for `nodes` (ascending, the same on every rank).
   SharedNodes shared_nodes(std::vector<Index> nodes) const;

@@ -30,6 +30,14 @@ struct Momenta {
   }
 };
 
+/// Runs f and adds its wall time to `seconds`.
+template <class F>
+void timed(double& seconds, F f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 struct BodyRow {
   double mass = 0;
   Vec3 mx = Vec3::Zero(), mv = Vec3::Zero();
@@ -98,11 +106,9 @@ double Simulation::next_dt() const {
 void Simulation::compute_forces() {
   if (cohesive_nodes_) {
     const std::span<Vec3> arrays[] = {x_};
-    dec_->share(*cohesive_nodes_, arrays);
+    timed(comm_seconds_, [&] { dec_->share(*cohesive_nodes_, arrays); });
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  last_elements_ = elements_.compute(x_, f_int_, stress6_);
-  element_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  timed(element_seconds_, [&] { last_elements_ = elements_.compute(x_, f_int_, stress6_); });
   if (fracture_) {
     const CohesiveEnergy ce = fracture_->add_forces(x_, f_int_);
     ledger_.cohesive_stored = ce.stored;
@@ -181,7 +187,7 @@ void Simulation::step() {
     // Every rank resolves the whole contact surface from the owners' states.
     if (surface_nodes_) {
       const std::span<Vec3> arrays[] = {x_prev_, x_, v_};
-      dec_->share(*surface_nodes_, arrays);
+      timed(comm_seconds_, [&] { dec_->share(*surface_nodes_, arrays); });
     }
     const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt);
     ledger_.contacts = r.contacts;
@@ -193,7 +199,7 @@ void Simulation::step() {
       ++ledger_.contact_capped_steps;
     }
   }
-  dec_->update_ghost_only(x_);
+  timed(comm_seconds_, [&] { dec_->update_ghost_only(x_); });
   // Gravity's work over the step's displacement (the projection's included),
   // per home granule.
   for (Index gr : dec_->owned_granules()) {
@@ -374,7 +380,7 @@ void Simulation::update_ledger() {
     }
   });
   std::vector<double> all = granule_sums_;
-  dec_->combine_granules(all);
+  timed(comm_seconds_, [&] { dec_->combine_granules(all); });
   double t[kGranuleSums] = {};
   for (Index gr = 0; gr < dec_->num_granules(); ++gr)
     for (int f = 0; f < kGranuleSums; ++f) t[f] += all[gr * kGranuleSums + f];
@@ -568,7 +574,8 @@ long Simulation::run() {
   fields_.reset();
   if (!opt_.out_dir.empty()) {
     if (fracture_) write_fragments();
-    if (root) write_summary(wall);
+    const DecompositionStats stats = dec_->stats();
+    if (root) write_summary(wall, stats);
   }
   return step_;
 }
@@ -588,7 +595,7 @@ void Simulation::write_fragments() {
   }
 }
 
-void Simulation::write_summary(double wall) {
+void Simulation::write_summary(double wall, const DecompositionStats& stats) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -605,9 +612,15 @@ void Simulation::write_summary(double wall) {
   j.add("element_updates_per_second",
         element_seconds_ > 0 ? double(dec_->local_elements().size()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
-  j.add("owned_elements_rank0", static_cast<long>(dec_->owned_elements()));
-  j.add("local_elements_rank0", static_cast<long>(dec_->local_elements().size()));
-  j.add("ghost_bytes_per_step_rank0", static_cast<long>(dec_->ghost_bytes()));
+  // Decomposition (docs/parallel.md): balance and bytes per step.
+  j.add("owned_elements_min", stats.owned_min);
+  j.add("owned_elements_max", stats.owned_max);
+  j.add("local_elements_max", stats.local_max);
+  j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
+  j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
+  j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
+  j.add("granule_sum_bytes_per_step", static_cast<long>(dec_->distributed() ? 8 * granule_sums_.size() : 0));
+  j.add("communication_time", comm_seconds_);
   j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
   j.add("elements", static_cast<long>(model_.mesh.num_elements()));
   j.add("element_order", model_.mesh.order);

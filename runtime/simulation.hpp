@@ -27,6 +27,7 @@ class ContactStage;
 class FractureStage;
 class Decomposition;
 struct SharedNodes;
+struct DecompositionStats;
 
 struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
@@ -103,7 +104,7 @@ class Simulation {
   void compute_forces();
   void update_ledger();
   void write_outputs(bool fields);
-  void write_summary(double wall_seconds);
+  void write_summary(double wall_seconds, const DecompositionStats& stats);
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
@@ -133,6 +134,7 @@ class Simulation {
   Ledger ledger_;
   ElementLoopResult last_elements_;
   double element_seconds_ = 0;
+  double comm_seconds_ = 0;  ///< in MPI exchanges of the step (ghosts, shared nodes, granule sums)
   double total0_ = 0, energy_scale_ = 0;
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)

@@ -1,0 +1,81 @@
+#!/bin/bash
+# MPI scaling of the decomposed time loop (issue 6, docs/performance.md "MPI"):
+# two unit boxes (the seeds' cube material) meet head-on, a contact scene.
+#
+#   bench/mpi_scaling.sh BUILD strong [ELEMENTS] [REPEATS]
+#       ranks x threads = 1x1, 1x2, 2x1 on ELEMENTS tets (default 500000),
+#       REPEATS runs each (default 3), medians of the loop wall time.
+#   bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
+#       R = 1, 2, 4, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
+#       tets per rank (default 2000), a few steps: balance and bytes per rank
+#       per step from summary.json (times are meaningless when oversubscribed).
+#
+# Results: bench/results/mpi_scaling_<mode>.csv
+set -euo pipefail
+build=${1:?usage: mpi_scaling.sh BUILD strong|weak ...}
+mode=${2:?strong or weak}
+here=$(cd "$(dirname "$0")" && pwd)
+shatter="$build/apps/shatter"
+mpi=(mpirun --allow-run-as-root --oversubscribe)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$here/results"
+
+scene="$work/boxes.yaml"
+cat > "$scene" <<'YAML'
+name: mpi_boxes
+time:
+  end: 6.0e-4
+output:
+  every: 0
+  history_every: 10
+materials:
+  seed: {model: neo_hookean, density: 0.0785, youngs_modulus: 21000, poisson_ratio: 0.3}
+contact: {}
+bodies:
+  - name: left
+    material: seed
+    mesh: {shape: box, size: [1.0, 1.0, 1.0], center: [-0.501, 0.0, 0.0], element_size: 0.1}
+    initial_velocity: [20.0, 0.0, 0.0]
+  - name: right
+    material: seed
+    mesh: {shape: box, size: [1.0, 1.0, 1.0], center: [0.501, 0.1, 0.0], element_size: 0.1}
+    initial_velocity: [-20.0, 0.0, 0.0]
+YAML
+# Element size for a target count: 9798 tets at h = 0.1, count ~ h^-2.93 (measured).
+size_for() { python3 -c "print(f'{0.1 * (9798 / $1) ** (1 / 2.93):.5f}')"; }
+key() { grep -o "\"$2\": [-0-9.e+]*" "$1/summary.json" | awk '{print $2}'; }
+
+if [ "$mode" = strong ]; then
+  elements=${3:-500000}
+  repeats=${4:-3}
+  h=$(size_for "$elements")
+  out="$here/results/mpi_scaling_strong.csv"
+  echo "ranks,threads,elements,steps,wall_median,element_loop,contact_search,contact_dcr,communication,load" > "$out"
+  for rt in "1 1" "1 2" "2 1"; do
+    set -- $rt
+    walls=()
+    for k in $(seq 1 "$repeats"); do
+      dir="$work/r$1t$2_$k"
+      "${mpi[@]}" -n "$1" "$shatter" run "$scene" --out "$dir" --threads "$2" --quiet \
+        --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
+      walls+=("$(key "$dir" wall_time)")
+    done
+    median=$(printf '%s\n' "${walls[@]}" | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
+    echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time),$(cut -d' ' -f1 /proc/loadavg)" | tee -a "$out"
+  done
+else
+  per_rank=${3:-2000}
+  max_ranks=${4:-64}
+  out="$here/results/mpi_scaling_weak.csv"
+  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,granule_sum_bytes,peak_memory_rank0" > "$out"
+  r=1
+  while [ "$r" -le "$max_ranks" ]; do
+    h=$(size_for $((per_rank * r)))
+    dir="$work/weak$r"
+    "${mpi[@]}" -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-5 \
+      --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
+    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" granule_sum_bytes_per_step),$(key "$dir" peak_memory_bytes)" | tee -a "$out"
+    r=$((r * 2))
+  done
+fi
