@@ -158,7 +158,7 @@ void Decomposition::rebuild_nodes() {
   }
 }
 
-void Decomposition::update_ghost_only(std::span<Vec3> x) {
+void Decomposition::update_ghost_only(std::span<Vec3> x) const {
   if (halo_) halo_->update_ghosts(x);
 }
 
@@ -185,7 +185,7 @@ SharedNodes Decomposition::shared_nodes(std::vector<Index> nodes) const {
   return s;
 }
 
-void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) {
+void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) const {
   if (size_ == 1) return;
   const int m = 3 * static_cast<int>(arrays.size());
   const std::vector<double> out = pack(plan, rank_, arrays);
@@ -196,7 +196,7 @@ void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec
   unpack(plan, in, arrays);
 }
 
-void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) {
+void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) const {
   if (size_ == 1) return;
   const int m = 3 * static_cast<int>(arrays.size());
   const std::vector<double> out = pack(all_nodes_, rank_, arrays);
@@ -207,7 +207,7 @@ void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) {
   if (rank_ == 0) unpack(all_nodes_, in, arrays);
 }
 
-void Decomposition::combine_granules(std::span<double> values) {
+void Decomposition::combine_granules(std::span<double> values) const {
   if (size_ > 1)
     MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
 }

@@ -97,7 +97,7 @@ class Decomposition {
   void for_touched(Index num_nodes, Body body) const;
 
   /// Positions of the ghost-only nodes from their owners.
-  void update_ghost_only(std::span<Vec3> x);
+  void update_ghost_only(std::span<Vec3> x) const;
   /// Bytes this rank sends per update_ghost_only.
   std::size_t ghost_bytes() const;
   /// Over all ranks (collective).
@@ -106,13 +106,13 @@ class Decomposition {
   /// The plan of share() for `nodes` (ascending, the same on every rank).
   SharedNodes shared_nodes(std::vector<Index> nodes) const;
   /// After the call every rank holds the owners' values of the plan's nodes in `arrays`.
-  void share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays);
+  void share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) const;
   /// Rank 0 receives the owners' values of every node (the others' arrays are unchanged).
-  void gather_to_root(std::span<const std::span<Vec3>> arrays);
+  void gather_to_root(std::span<const std::span<Vec3>> arrays) const;
 
   /// In place: per-granule partials [g * k + c], non-zero only on the
   /// granule's owner, become the same complete array on every rank (exact).
-  void combine_granules(std::span<double> values);
+  void combine_granules(std::span<double> values) const;
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
   /// Global minimum (exact in any order).

@@ -1,0 +1,132 @@
+// The decomposition of the time loop (runtime/decomposition.hpp), run at 1, 2
+// and 3 ranks: ownership covers everything once, a touched node has its whole
+// star locally, ghost updates and shares deliver the owners' values, granule
+// sums are exact, and the restricted element loop gives touched nodes the
+// serial forces bit for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "mpi_environment.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/element_forces.hpp"
+#include "runtime/model.hpp"
+#include "scene_text.hpp"
+
+namespace shatter {
+namespace {
+
+const Model& box() {
+  static const Model m = [] {
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    return build_model(test::scene_from_text(
+        "decomposition_box_rank" + std::to_string(rank),
+        "name: decomposition_box\n"
+        "time: {end: 1.0}\n"
+        "materials:\n"
+        "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+        "bodies:\n"
+        "  - name: b\n"
+        "    material: steel\n"
+        "    mesh: {shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1}\n"));
+  }();
+  return m;
+}
+
+/// A value every rank can compute for node n, and a non-affine deformation.
+Vec3 tag(Index n) { return Vec3(n, 0.5 * n + 1, -3.0 * n); }
+Vec3 deformed(const Vec3& X) {
+  return X + Vec3(0.01 * std::sin(60 * X.y()) * X.x(), 0.02 * X.x() * std::cos(40 * X.z()) - 0.01 * X.y(),
+                  0.015 * X.z() * std::sin(50 * X.x()));
+}
+
+bool same_bits(const Vec3& a, const Vec3& b) { return std::memcmp(a.data(), b.data(), sizeof(Vec3)) == 0; }
+
+TEST(Decomposition, OwnershipCoversEverythingOnce) {
+  const Model& m = box();
+  const Decomposition d(m, MPI_COMM_WORLD);
+  const Mesh& mesh = m.mesh;
+  // Every granule belongs to one rank; the owned granules of all ranks add up.
+  long owned = static_cast<long>(d.owned_granules().size()), total = 0;
+  MPI_Allreduce(&owned, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(total, d.num_granules());
+  for (Index g : d.owned_granules()) EXPECT_TRUE(d.owns_granule(g));
+  // Home granules split the nodes: each node once, in the granule of its first element.
+  std::vector<int> seen(mesh.num_nodes(), 0);
+  for (Index g = 0; g < d.num_granules(); ++g)
+    for (Index n : d.home_nodes(g)) {
+      ++seen[n];
+      EXPECT_EQ(mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule, g);
+    }
+  for (Index n = 0; n < mesh.num_nodes(); ++n) EXPECT_EQ(seen[n], 1);
+  // A touched node's whole star is local; the home node of an owned granule is touched here.
+  const auto local = d.local_elements();
+  for (Index n : d.touched_nodes())
+    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
+      EXPECT_TRUE(std::binary_search(local.begin(), local.end(), mesh.node_elem[p]));
+  const auto touched = d.touched_nodes();
+  for (Index g : d.owned_granules())
+    for (Index n : d.home_nodes(g)) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), n));
+  if (d.size() > 1) EXPECT_LT(static_cast<Index>(local.size()), mesh.num_elements());
+}
+
+TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
+  const Model& m = box();
+  Decomposition d(m, MPI_COMM_WORLD);
+  const Index nn = m.mesh.num_nodes();
+  // Only touched nodes hold the right value; the rest is garbage.
+  std::vector<Vec3> x(nn, Vec3::Constant(-7.0));
+  for (Index n : d.touched_nodes()) x[n] = tag(n);
+  d.update_ghost_only(x);
+  for (Index n : d.held_nodes()) EXPECT_TRUE(same_bits(x[n], tag(n))) << "node " << n;
+  // Share every third node with every rank; gather all to rank 0.
+  std::vector<Index> subset;
+  for (Index n = 0; n < nn; n += 3) subset.push_back(n);
+  const SharedNodes plan = d.shared_nodes(subset);
+  std::vector<Vec3> y(nn, Vec3::Constant(-7.0)), z(nn, Vec3::Constant(-7.0));
+  for (Index n : d.touched_nodes()) y[n] = tag(n), z[n] = -tag(n);
+  const std::span<Vec3> arrays[] = {y, z};
+  d.share(plan, arrays);
+  for (Index n : subset) EXPECT_TRUE(same_bits(y[n], tag(n)) && same_bits(z[n], Vec3(-tag(n)))) << "node " << n;
+  d.gather_to_root(arrays);
+  if (d.rank() == 0)
+    for (Index n = 0; n < nn; ++n) EXPECT_TRUE(same_bits(y[n], tag(n))) << "node " << n;
+  // allgather: the ranks' lists in rank order.
+  const std::vector<Index> mine(d.rank() + 1, d.rank());
+  const std::vector<Index> all = d.allgather(mine);
+  ASSERT_EQ(static_cast<int>(all.size()), d.size() * (d.size() + 1) / 2);
+  for (size_t i = 1; i < all.size(); ++i) EXPECT_LE(all[i - 1], all[i]);
+}
+
+TEST(Decomposition, GranuleSumsAreExactAndRestrictedForcesAreSerial) {
+  const Model& m = box();
+  const Decomposition d(m, MPI_COMM_WORLD);
+  const Index nn = m.mesh.num_nodes();
+  std::vector<Vec3> x(nn);
+  for (Index n = 0; n < nn; ++n) x[n] = deformed(m.mesh.reference[n]);
+
+  ElementForces serial(m), restricted(m);
+  std::vector<Vec3> f_serial(nn), f(nn, Vec3::Constant(1e300));
+  const ElementLoopResult whole = serial.compute(x, f_serial);
+  if (d.distributed()) restricted.restrict_to(d.local_elements(), d.held_nodes());
+  restricted.compute(x, f);
+  for (Index n : d.touched_nodes()) EXPECT_TRUE(same_bits(f[n], f_serial[n])) << "node " << n;
+
+  // Owned granules' energies, combined, summed in granule order: the serial total.
+  std::vector<double> e(d.num_granules(), 0.0);
+  for (Index g : d.owned_granules()) e[g] = restricted.granule_energy()[g];
+  d.combine_granules(e);
+  double total = 0;
+  for (Index g = 0; g < d.num_granules(); ++g) {
+    EXPECT_EQ(e[g], serial.granule_energy()[g]) << "granule " << g;
+    total += e[g];
+  }
+  EXPECT_EQ(total, whole.strain_energy);
+  EXPECT_GT(total, 0.0);
+}
+
+}  // namespace
+}  // namespace shatter
