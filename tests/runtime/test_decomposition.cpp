@@ -70,7 +70,9 @@ TEST(Decomposition, OwnershipCoversEverythingOnce) {
   const auto touched = d.touched_nodes();
   for (Index g : d.owned_granules())
     for (Index n : d.home_nodes(g)) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), n));
-  if (d.size() > 1) EXPECT_LT(static_cast<Index>(local.size()), mesh.num_elements());
+  if (d.size() > 1) {
+    EXPECT_LT(static_cast<Index>(local.size()), mesh.num_elements());
+  }
 }
 
 TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
@@ -92,8 +94,9 @@ TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
   d.share(plan, arrays);
   for (Index n : subset) EXPECT_TRUE(same_bits(y[n], tag(n)) && same_bits(z[n], Vec3(-tag(n)))) << "node " << n;
   d.gather_to_root(arrays);
-  if (d.rank() == 0)
+  if (d.rank() == 0) {
     for (Index n = 0; n < nn; ++n) EXPECT_TRUE(same_bits(y[n], tag(n))) << "node " << n;
+  }
   // allgather: the ranks' lists in rank order.
   const std::vector<Index> mine(d.rank() + 1, d.rank());
   const std::vector<Index> all = d.allgather(mine);
