@@ -137,9 +137,6 @@ int main(int argc, char** argv) {
     if (*check) {
       print_check(model, sim);
     } else {
-      if (scene.checkpoint && scene.fracture_enabled() && !quiet && rank == 0)
-        std::fprintf(stderr, "warning: %s: checkpoint: not written for scenes with fracture (a restart of a "
-                     "cracked mesh is not implemented); the key is ignored\n", scene.file.c_str());
       install_stop_handlers();
       const long steps = sim.run();
       if (!quiet && rank == 0)

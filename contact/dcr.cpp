@@ -104,6 +104,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
   }
   result.capped = !converged;
   for (size_t i = 0; i < pairs.size(); ++i) {
+    if (result.capped && result.unresolved < 0 && active_now[i]) result.unresolved = static_cast<Index>(i);
     result.contacts += ever_active[i];
     result.dissipated += dissipated[i];
   }

@@ -30,6 +30,7 @@ struct DcrResult {
   int sweeps = 0;           ///< sweeps run, the last one included
   double dissipated = 0.0;  ///< kinetic energy lost by the impacts and friction, J
   bool capped = false;      ///< max_sweeps reached with penetrations still being resolved
+  Index unresolved = -1;    ///< when capped: the first pair (in pair order) still penetrating in the last sweep
 };
 
 /// Pairs grouped by color, as built by greedy_coloring (runtime/coloring.hpp) over the

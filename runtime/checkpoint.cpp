@@ -61,6 +61,48 @@ class QuietHdf5 {
   void* data_ = nullptr;
 };
 
+/// HDF5 types of the arrays a checkpoint holds: file() as stored
+/// (little-endian, fixed width), memory() as held.
+template <class T>
+struct FileType;
+template <>
+struct FileType<double> {
+  static constexpr hsize_t numbers = 1;  // per element of the vector
+  static hid_t file() { return H5T_IEEE_F64LE; }
+  static hid_t memory() { return H5T_NATIVE_DOUBLE; }
+};
+template <>
+struct FileType<Vec3> : FileType<double> {
+  static constexpr hsize_t numbers = 3;
+};
+template <>
+struct FileType<std::int64_t> {
+  static constexpr hsize_t numbers = 1;
+  static hid_t file() { return H5T_STD_I64LE; }
+  static hid_t memory() { return H5T_NATIVE_INT64; }
+};
+template <>
+struct FileType<std::int32_t> {
+  static constexpr hsize_t numbers = 1;
+  static hid_t file() { return H5T_STD_I32LE; }
+  static hid_t memory() { return H5T_NATIVE_INT32; }
+};
+template <>
+struct FileType<std::int8_t> {
+  static constexpr hsize_t numbers = 1;
+  static hid_t file() { return H5T_STD_I8LE; }
+  static hid_t memory() { return H5T_NATIVE_INT8; }
+};
+template <>
+struct FileType<std::uint8_t> {
+  static constexpr hsize_t numbers = 1;
+  static hid_t file() { return H5T_STD_U8LE; }
+  static hid_t memory() { return H5T_NATIVE_UINT8; }
+};
+template <>
+struct FileType<FacetState> : FileType<std::uint8_t> {};
+static_assert(sizeof(FacetState) == 1);
+
 // ---- writing: every failure throws Error naming the temporary file ----
 
 struct Writer {
@@ -86,19 +128,25 @@ struct Writer {
     check(type.valid() && H5Tset_size(type.get(), s.size() + 1) >= 0, "make a string type");
     attribute(object, name, type.get(), s.c_str());
   }
-  void rows(hid_t group, const char* name, const std::vector<Vec3>& a) const {
-    const std::array<hsize_t, 2> dims{a.size(), 3};
+  /// A dataset of rows of `cols` numbers from `a` (a Vec3 is 3 numbers),
+  /// with attribute fnv1a64, the hash of its bytes.
+  template <class T>
+  void array(hid_t group, const char* name, const std::vector<T>& a, hsize_t cols = 1) const {
+    const hsize_t numbers = a.size() * FileType<T>::numbers;
+    SHATTER_REQUIRE(numbers % cols == 0, "checkpoint: dataset " << name << " is not a whole number of rows");
+    const std::array<hsize_t, 2> dims{numbers / cols, cols};
     H5Handle space(H5Screate_simple(2, dims.data(), nullptr), H5Sclose);
     H5Handle dset(
-        H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+        H5Dcreate2(group, name, FileType<T>::file(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
         H5Dclose);
     check(space.valid() && dset.valid(), std::string("create dataset ") + name);
     if (!a.empty())
-      check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
+      check(H5Dwrite(dset.get(), FileType<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
             std::string("write dataset ") + name);
-    const std::uint64_t h = fnv1a(a.data(), a.size() * sizeof(Vec3));
+    const std::uint64_t h = fnv1a(a.data(), a.size() * sizeof(T));
     attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &h);
   }
+  void rows(hid_t group, const char* name, const std::vector<Vec3>& a) const { array(group, name, a, 3); }
 };
 
 /// fsync of a file or folder; throws naming it.
@@ -151,26 +199,32 @@ struct Reader {
             std::string("cannot read attribute ") + name);
     return s.c_str();
   }
-  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected) const {
+  /// Reads a dataset written by Writer::array: `expected` rows of `cols`
+  /// numbers, hash checked.
+  template <class T>
+  std::vector<T> array(hid_t group, const char* name, std::size_t expected, hsize_t cols = 1) const {
     H5Handle dset(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
     require(dset.valid(),
             std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
     H5Handle space(H5Dget_space(dset.get()), H5Sclose);
     std::array<hsize_t, 2> dims{0, 0};
     require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
-                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == 3 &&
+                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == cols &&
                 dims[0] == expected,
             std::string("dataset ") + name + " has the wrong shape (expected " +
-                std::to_string(expected) + " x 3)");
-    std::vector<Vec3> a(expected);
+                std::to_string(expected) + " x " + std::to_string(cols) + ")");
+    std::vector<T> a(expected * cols / FileType<T>::numbers);
     if (expected > 0)
-      require(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
+      require(H5Dread(dset.get(), FileType<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
               std::string("cannot read dataset ") + name + " (truncated or corrupted checkpoint?)");
     std::uint64_t h = 0;
     attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &h);
-    require(h == fnv1a(a.data(), a.size() * sizeof(Vec3)),
+    require(h == fnv1a(a.data(), a.size() * sizeof(T)),
             std::string("dataset ") + name + " fails its hash check (corrupted checkpoint)");
     return a;
+  }
+  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected) const {
+    return array<Vec3>(group, name, expected, 3);
   }
 };
 
@@ -211,11 +265,10 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.text(root, "format", kFormat);
     w.integer(root, "version", kVersion);
     w.text(root, "scene", model.scene.name);
-    w.integer(root, "nodes", model.mesh.num_nodes());
+    w.integer(root, "nodes", s.model_nodes);
     w.integer(root, "elements", model.mesh.num_elements());
     w.integer(root, "order", model.mesh.order);
-    const std::uint64_t fp = model_fingerprint(model);
-    w.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &fp);
+    w.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &s.model_fingerprint);
     w.integer(root, "step", s.step);
     w.number(root, "time", s.time);
     w.number(root, "dt", s.dt);
@@ -253,6 +306,33 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.integer(g, "cohesive_elements", l.cohesive_elements);
     w.integer(g, "fragments", l.fragments);
     w.integer(g, "contact_capped_steps", l.contact_capped_steps);
+
+    if (s.fracture) {
+      const FractureState& f = *s.fracture;
+      H5Handle group(H5Gcreate2(root, "fracture", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      w.check(group.valid(), "create group /fracture");
+      const hid_t fr = group.get();
+      w.integer(fr, "nodes", static_cast<long>(f.reference.size()));
+      w.integer(fr, "facets", static_cast<long>(f.facet_state.size()));
+      w.integer(fr, "cohesive_elements", f.cohesive.size());
+      w.attribute(fr, "mesh_revision", H5T_NATIVE_UINT64, &f.mesh_revision);
+      w.rows(fr, "reference", f.reference);
+      w.array(fr, "node_gid", f.node_gid);
+      w.array(fr, "node_body", f.node_body);
+      w.array(fr, "conn", f.conn, model.mesh.nodes_per_element());
+      w.array(fr, "mass", f.mass);
+      w.array(fr, "bc_mask", f.bc_mask);
+      w.rows(fr, "bc_velocity", f.bc_velocity);
+      w.rows(fr, "initial_velocity", f.initial_velocity);
+      w.array(fr, "facet_state", f.facet_state);
+      const CohesiveElements& c = f.cohesive;
+      w.array(fr, "cohesive_facet", c.facet);
+      w.array(fr, "cohesive_side_local", c.side_local, kCohesiveSlots);
+      w.array(fr, "cohesive_side_nodes", c.side_nodes, kCohesiveSlots);
+      w.array(fr, "cohesive_area", c.area);
+      w.rows(fr, "cohesive_normal", c.normal);
+      w.array(fr, "cohesive_delta_max", c.delta_max, kCohesivePoints);
+    }
     w.check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL) >= 0, "flush the file");
   }  // closed here: everything is in the OS's hands
   sync_path(tmp, O_RDONLY);
@@ -267,10 +347,6 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model) {
   const Reader r{path.string()};
-  if (model.scene.fracture_enabled())
-    r.fail(
-        "restart of a scene with fracture is not implemented: a checkpoint does not hold the split "
-        "nodes, cohesive elements and fragments, so the run could not continue to the same answer");
   r.require(std::filesystem::is_regular_file(path), "no such file");
   const QuietHdf5 quiet;
   r.require(H5Fis_hdf5(path.c_str()) > 0,
@@ -309,6 +385,44 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
             "conditions changed)");
 
   SimulationState s;
+  s.model_fingerprint = fp;
+  s.model_nodes = nodes;
+  // With fracture, the state's node arrays include the split copies.
+  std::size_t n = model.mesh.num_nodes();
+  const bool has_fracture = H5Lexists(root, "fracture", H5P_DEFAULT) > 0;
+  r.require(has_fracture == model.scene.fracture_enabled(),
+            has_fracture ? "the checkpoint has a fracture state but the scene has no fracture block"
+                         : "the scene has fracture but the checkpoint has no fracture state (written by an "
+                           "older shatter?)");
+  if (has_fracture) {
+    H5Handle group(H5Gopen2(root, "fracture", H5P_DEFAULT), H5Gclose);
+    r.require(group.valid(), "group /fracture is unreadable (truncated or corrupted checkpoint?)");
+    const hid_t fr = group.get();
+    const long fn = r.integer(fr, "nodes"), facets = r.integer(fr, "facets"),
+               cohesive = r.integer(fr, "cohesive_elements");
+    r.require(fn >= nodes && facets >= 0 && cohesive >= 0 && cohesive <= facets,
+              "/fracture has impossible counts (corrupted checkpoint?)");
+    n = static_cast<std::size_t>(fn);
+    FractureState& f = s.fracture.emplace();
+    r.attribute(fr, "mesh_revision", H5T_NATIVE_UINT64, &f.mesh_revision);
+    f.reference = r.rows(fr, "reference", n);
+    f.node_gid = r.array<GlobalId>(fr, "node_gid", n);
+    f.node_body = r.array<int>(fr, "node_body", n);
+    f.conn = r.array<Index>(fr, "conn", static_cast<std::size_t>(elements), model.mesh.nodes_per_element());
+    f.mass = r.array<double>(fr, "mass", n);
+    f.bc_mask = r.array<std::uint8_t>(fr, "bc_mask", n);
+    f.bc_velocity = r.rows(fr, "bc_velocity", n);
+    f.initial_velocity = r.rows(fr, "initial_velocity", n);
+    f.facet_state = r.array<FacetState>(fr, "facet_state", static_cast<std::size_t>(facets));
+    CohesiveElements& c = f.cohesive;
+    const auto nc = static_cast<std::size_t>(cohesive);
+    c.facet = r.array<Index>(fr, "cohesive_facet", nc);
+    c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots);
+    c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots);
+    c.area = r.array<double>(fr, "cohesive_area", nc);
+    c.normal = r.rows(fr, "cohesive_normal", nc);
+    c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints);
+  }
   s.step = r.integer(root, "step");
   s.time = r.number(root, "time");
   s.dt = r.number(root, "dt");
@@ -317,9 +431,8 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   s.energy_scale = r.number(root, "energy_scale");
   H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);
   r.require(state.valid(), "group /state is missing (truncated or corrupted checkpoint?)");
-  const std::size_t n = model.mesh.num_nodes();
   std::size_t b = 0;
-  for (std::uint8_t m : model.bc_mask) b += m != 0;
+  for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
   s.x = r.rows(state.get(), "positions", n);
   s.v = r.rows(state.get(), "velocities", n);
   s.a = r.rows(state.get(), "accelerations", n);

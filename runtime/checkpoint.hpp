@@ -4,17 +4,18 @@
 // written atomically, read back into a Simulation of the same model so that
 // the continued run is bitwise the run that was never stopped.
 //
-// Layout of checkpoint.h5 (n = nodes, b = nodes with a prescribed component,
+// Layout of checkpoint.h5 (n = nodes now, with fracture's split copies;
+// b = nodes with a prescribed component,
 // in the order of Model::bc_mask; file format "latest", so every object header
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
 //       version       int64 1
 //       scene         string, Scene::name
-//       nodes         int64 n
+//       nodes         int64, nodes of the model as built (before fracture)
 //       elements      int64
 //       order         int64, 1 = TET4, 2 = TET10
-//       fingerprint   uint64, model_fingerprint() of the model written
+//       fingerprint   uint64, model_fingerprint() of the model as built
 //       step          int64, steps done
 //       time, dt      float64, s: time reached, length of the last step
 //       stable_dt     float64, s: stable step of the state, no safety factor
@@ -30,9 +31,18 @@
 //       (float64 kinetic ... external_work, px py pz, Lx Ly Lz; int64 contacts,
 //       cohesive_elements, fragments, contact_capped_steps)
 //
+//   /fracture  only for scenes with fracture (FractureState, fracture_stage.hpp);
+//       attributes nodes (n), facets (f), cohesive_elements (c), mesh_revision;
+//       datasets, each with fnv1a64 like /state's:
+//       reference n x 3, node_gid n (int64), node_body n (int32),
+//       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3,
+//       initial_velocity n x 3, facet_state f (uint8: 0 intact, 1 cohesive,
+//       2 free), cohesive_facet c (int32), cohesive_side_local c x 12 (int8),
+//       cohesive_side_nodes c x 12 (int32), cohesive_area c, cohesive_normal
+//       c x 3, cohesive_delta_max c x 3 (m)
+//
 // Contact needs nothing more: its surface is rebuilt from the mesh and its
-// pair lists are scratch of one step. Fracture (split nodes, cohesive
-// elements) is not saved: scenes with fracture are refused.
+// pair lists are filtered to a fresh search's every step.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -48,7 +58,7 @@ namespace shatter {
 /// (time.safety, time.end, output, checkpoint) may differ at a restart.
 std::uint64_t model_fingerprint(const Model& model);
 
-/// Writes `state` of a run of `model` to `path` atomically: `path`.tmp is
+/// Writes `state` (from Simulation::save_state) of a run of `model` to `path` atomically: `path`.tmp is
 /// written, flushed and fsync'ed, then renamed over `path` (and the folder
 /// fsync'ed), so `path` is always either the previous checkpoint or this one.
 /// `failure`: empty, or the message of the error the step after `state` threw.
@@ -60,8 +70,8 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 /// Reads a checkpoint of `model` written by write_checkpoint. Throws
 /// InputError naming the path and the reason when the file is missing,
 /// truncated or corrupted (HDF5 or hash check), of another scene or model
-/// (name, counts, fingerprint), or when the scene has fracture (topology and
-/// cohesive state are not saved).
+/// (name, counts, fingerprint), or has a fracture state exactly when the
+/// scene has no fracture.
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model);
 
 /// Removes the rows of a CSV file whose first column (step) is above `step`,

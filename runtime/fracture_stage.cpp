@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "fracture/facet_criterion.hpp"
+#include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 
 namespace shatter {
@@ -71,6 +72,68 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
 Index FractureStage::release() {
   if (cohesive_.size() == 0) return 0;
   return release_debonded(model_.mesh, topology_, cohesive_, laws_);
+}
+
+void FractureStage::save(FractureState& s) const {
+  const Mesh& mesh = model_.mesh;
+  if (s.mesh_revision != mesh.revision) {
+    s.mesh_revision = mesh.revision;
+    s.reference = mesh.reference;
+    s.node_gid = mesh.node_gid;
+    s.node_body = mesh.node_body;
+    s.conn = mesh.conn;
+    s.mass = model_.mass;
+    s.bc_mask = model_.bc_mask;
+    s.bc_velocity = model_.bc_velocity;
+    s.initial_velocity = model_.initial_velocity;
+  }
+  s.facet_state = topology_.facet_state;
+  s.cohesive = cohesive_;
+}
+
+void FractureStage::restore(const FractureState& s) {
+  Mesh& mesh = model_.mesh;
+  const size_t n = s.reference.size(), ne = mesh.num_elements(), k = mesh.nodes_per_element();
+  SHATTER_REQUIRE(n >= static_cast<size_t>(mesh.num_nodes()) && s.node_gid.size() == n && s.node_body.size() == n &&
+                      s.mass.size() == n && s.bc_mask.size() == n && s.bc_velocity.size() == n &&
+                      s.initial_velocity.size() == n && s.conn.size() == ne * k,
+                  "fracture state: node arrays of " << n << " nodes and " << s.conn.size() / k
+                                                    << " elements do not fit the model (" << mesh.num_nodes()
+                                                    << " nodes before fracture, " << ne << " elements)");
+  SHATTER_REQUIRE(s.facet_state.size() == static_cast<size_t>(topology_.num_facets()),
+                  "fracture state: " << s.facet_state.size() << " facets, the model has "
+                                     << topology_.num_facets());
+  for (FacetState f : s.facet_state)
+    SHATTER_REQUIRE(f == FacetState::intact || f == FacetState::cohesive || f == FacetState::free,
+                    "fracture state: facet state " << int(f) << " is not one of intact, cohesive, free");
+  const CohesiveElements& c = s.cohesive;
+  const size_t nc = c.facet.size();
+  SHATTER_REQUIRE(c.side_local.size() == nc * kCohesiveSlots && c.side_nodes.size() == nc * kCohesiveSlots && c.area.size() == nc &&
+                      c.normal.size() == nc && c.delta_max.size() == nc * kCohesivePoints,
+                  "fracture state: the cohesive element arrays disagree in size");
+  for (Index a : s.conn) SHATTER_REQUIRE(a >= 0 && static_cast<size_t>(a) < n, "fracture state: node " << a << " in conn is out of range");
+  for (Index f : c.facet)
+    SHATTER_REQUIRE(f >= 0 && f < topology_.num_facets() && s.facet_state[f] != FacetState::intact,
+                    "fracture state: cohesive facet " << f << " is out of range or intact");
+  for (Index a : c.side_nodes)
+    SHATTER_REQUIRE(a >= -1 && (a < 0 || static_cast<size_t>(a) < n), "fracture state: side node " << a << " is out of range");
+  for (std::int8_t a : c.side_local)
+    SHATTER_REQUIRE(a >= -1 && a < static_cast<int>(k), "fracture state: local node " << int(a) << " is out of range");
+  for (int b : s.node_body)
+    SHATTER_REQUIRE(b >= 0 && static_cast<size_t>(b) < model_.scene.bodies.size(), "fracture state: body " << b << " is out of range");
+
+  mesh.reference = s.reference;
+  mesh.node_gid = s.node_gid;
+  mesh.node_body = s.node_body;
+  mesh.conn = s.conn;
+  mesh.build_node_elements();
+  mesh.revision = s.mesh_revision;
+  model_.mass = s.mass;
+  model_.bc_mask = s.bc_mask;
+  model_.bc_velocity = s.bc_velocity;
+  model_.initial_velocity = s.initial_velocity;
+  topology_.facet_state = s.facet_state;
+  cohesive_ = s.cohesive;
 }
 
 }  // namespace shatter

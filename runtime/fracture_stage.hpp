@@ -3,6 +3,7 @@
 // of cohesive elements with node splitting, cohesive forces and fragments,
 // for scenes with a material that has a fracture block.
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -12,6 +13,34 @@
 #include "runtime/model.hpp"
 
 namespace shatter {
+
+/// Node slots per cohesive element in CohesiveElements::side_local and
+/// side_nodes: 2 sides x 6 (fracture/cohesive_elements.hpp).
+inline constexpr int kCohesiveSlots = 2 * 6;
+
+/// What fracture changed in a run since its model was built, between two
+/// steps: the part of a checkpoint (runtime/checkpoint.hpp, /fracture) that
+/// lets a restarted run continue bitwise. Layouts (n = nodes now: split
+/// copies follow the built nodes; e = elements, k = nodes per element,
+/// f = facets of the Topology):
+///   mesh_revision  Mesh::revision these arrays are of
+///   reference[n] (m), node_gid[n], node_body[n], conn[e k]: the mesh after splits
+///   mass[n] (kg), bc_mask[n], bc_velocity[n] (m/s), initial_velocity[n] (m/s):
+///                  the model's per-node arrays, grown with the mesh
+///   facet_state[f] Topology::facet_state
+///   cohesive       every cohesive element with its delta_max
+struct FractureState {
+  std::uint64_t mesh_revision = ~std::uint64_t{0};  ///< none copied yet
+  std::vector<Vec3> reference;
+  std::vector<GlobalId> node_gid;
+  std::vector<int> node_body;
+  std::vector<Index> conn;
+  std::vector<double> mass;
+  std::vector<std::uint8_t> bc_mask;
+  std::vector<Vec3> bc_velocity, initial_velocity;
+  std::vector<FacetState> facet_state;
+  CohesiveElements cohesive;
+};
 
 class FractureStage {
  public:
@@ -52,6 +81,16 @@ class FractureStage {
   Index cohesive_count() const { return cohesive_.size(); }
   /// Per element damage in [0, 1] (element_damage), for output.
   std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws_); }
+
+  /// Copies the fracture state into `state`, reusing its storage; the mesh
+  /// and per-node model arrays only when the mesh changed since `state` was
+  /// last filled (its mesh_revision), so saving every step is cheap.
+  void save(FractureState& state) const;
+  /// Puts `state` (saved from a run of the same model) back into the model's
+  /// mesh and per-node arrays, the facet states and the cohesive elements.
+  /// The caller resizes its own nodal arrays to the mesh. Throws Error when
+  /// the arrays do not fit the model (sizes, node or facet ids out of range).
+  void restore(const FractureState& state);
   double check_seconds() const { return check_seconds_; }
 
  private:

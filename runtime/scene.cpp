@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -176,12 +177,20 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  Reader r(path);
   if (!std::filesystem::is_regular_file(path))
     throw InputError(path + ": the scene file does not exist or is not a file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw InputError(path + ": the scene file cannot be read");
+  return parse_scene(text.str(), path, overrides);
+}
+
+Scene parse_scene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  Reader r(path);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     std::ostringstream os;
     os << path << ":" << e.mark.line + 1 << ":" << e.mark.column + 1 << ": not valid YAML: " << e.msg;
@@ -332,7 +341,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   if (const YAML::Node c = root["contact"]) {
     ContactSpec cs;
     if (!c.IsNull()) {
-      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin", "placement"});
+      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin", "placement", "on_sweep_cap"});
       if (c["friction"]) {
         cs.friction = r.number(c["friction"], "contact.friction");
         if (cs.friction < 0) r.fail("contact.friction", "a Coulomb coefficient >= 0", c["friction"]);
@@ -341,7 +350,16 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
         cs.restitution = r.number(c["restitution"], "contact.restitution");
         if (cs.restitution < 0 || cs.restitution > 1) r.fail("contact.restitution", "a value in [0, 1]", c["restitution"]);
       }
-      if (c["max_sweeps"]) cs.max_sweeps = static_cast<int>(r.count(c["max_sweeps"], "contact.max_sweeps", 1));
+      if (c["max_sweeps"]) {
+        const long sweeps = r.count(c["max_sweeps"], "contact.max_sweeps", 1);
+        if (sweeps > 1000000) r.fail("contact.max_sweeps", "an integer in [1, 1000000]", c["max_sweeps"]);
+        cs.max_sweeps = static_cast<int>(sweeps);
+      }
+      if (c["on_sweep_cap"]) {
+        const std::string what = r.string(c["on_sweep_cap"], "contact.on_sweep_cap");
+        if (what != "warn" && what != "fail") r.fail("contact.on_sweep_cap", "warn or fail", c["on_sweep_cap"]);
+        cs.sweep_cap_fatal = what == "fail";
+      }
       if (c["search_margin"]) {
         cs.search_margin = r.number(c["search_margin"], "contact.search_margin");
         if (!(cs.search_margin >= 0))

@@ -52,6 +52,7 @@ struct ContactSpec {
   int max_sweeps = 100;       ///< cap on DCR Gauss-Seidel sweeps per step (contact.max_sweeps)
   double search_margin = 0.1; ///< candidate reuse margin, fraction of the median surface edge (contact.search_margin)
   bool mid_step = false;     ///< contact.placement: false = end (of the step), true = middle
+  bool sweep_cap_fatal = false;  ///< contact.on_sweep_cap: fail (the run stops, exit 1) instead of warn
 };
 
 struct CheckpointSpec {
@@ -85,5 +86,11 @@ struct Scene {
 /// Load and check a scene. `overrides` are "key.path=value" strings (the
 /// CLI's --set), applied to the YAML tree before checking; value is YAML.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// The same from the scene's text; `path` names the file in messages and
+/// resolves relative mesh files (tests/fuzz/fuzz_scene.cpp feeds it any bytes:
+/// every problem must be an InputError).
+Scene parse_scene(const std::string& text, const std::string& path,
+                  const std::vector<std::string>& overrides = {});
 
 }  // namespace shatter

@@ -43,6 +43,47 @@ struct BodyRow {
   Vec3 mx = Vec3::Zero(), mv = Vec3::Zero();
 };
 
+/// What, where and when for a step whose DCR sweeps reached the cap, when
+/// the scene says contact.on_sweep_cap: fail. `step` is the step under way.
+std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const ContactPairs& pairs,
+                                const DcrResult& r, long step, double time) {
+  std::ostringstream os;
+  os << "step " << step << ", t = " << time << " s: DCR sweeps reached the cap (contact.max_sweeps = " << r.sweeps
+     << ") with penetrations left (contact.on_sweep_cap: fail)";
+  if (r.unresolved >= 0 && static_cast<size_t>(r.unresolved) < pairs.size()) {
+    const ContactPair& p = pairs[r.unresolved];
+    Vec3 centre = Vec3::Zero();
+    os << "; still penetrating: " << (p.kind == ContactPair::VertexFace ? "vertex-face" : "edge-edge")
+       << " pair of nodes";
+    for (const Index n : p.nodes) {
+      os << " " << model.mesh.node_gid[n] << " ('" << model.scene.bodies[model.mesh.node_body[n]].name << "')";
+      centre += 0.25 * x[n];
+    }
+    os << " near (" << centre.x() << ", " << centre.y() << ", " << centre.z() << ")";
+  }
+  os << "; try a smaller time.safety or a larger contact.max_sweeps";
+  return os.str();
+}
+
+/// What, where and when for a ledger that is no longer finite at the end of
+/// step `step` (a NaN or overflow that has not reached the positions yet).
+std::string non_finite_diagnosis(const Model& model, std::span<const Vec3> x, std::span<const Vec3> v,
+                                 std::span<const Vec3> a, const Ledger& l, long step, double time) {
+  std::ostringstream os;
+  os << "step " << step << ", t = " << time << " s: the energy ledger is not finite (kinetic " << l.kinetic
+     << ", strain " << l.strain << ", cohesive " << l.cohesive_stored << " + " << l.cohesive_dissipated
+     << ", contact " << l.contact_dissipated << ", external work " << l.external_work << ")";
+  for (size_t i = 0; i < v.size(); ++i)
+    if (!v[i].allFinite() || !a[i].allFinite()) {
+      os << "; node " << model.mesh.node_gid[i] << " (body '" << model.scene.bodies[model.mesh.node_body[i]].name
+         << "') at (" << x[i].x() << ", " << x[i].y() << ", " << x[i].z() << ") has velocity (" << v[i].x() << ", "
+         << v[i].y() << ", " << v[i].z() << ")";
+      break;
+    }
+  os << "; try a smaller time.safety or a finer mesh";
+  return os.str();
+}
+
 }  // namespace
 
 Simulation::Simulation(Model& model, RunOptions options)
@@ -60,23 +101,16 @@ Simulation::Simulation(Model& model, RunOptions options)
                   "between processes)");
   }
   const Index n = mesh.num_nodes();
+  model_fingerprint_ = model_fingerprint(model_);
+  model_nodes_ = n;
   x_ = mesh.reference;
   v_ = model_.initial_velocity;
   a_.assign(n, Vec3::Zero());
   f_int_.assign(n, Vec3::Zero());
   f_ext_.assign(n, Vec3::Zero());
-  inv_mass_.resize(n);
-  for (Index i = 0; i < n; ++i) {
-    inv_mass_[i] = 1.0 / model_.mass[i];
-    if (model_.bc_mask[i]) bc_nodes_.push_back(i);
-  }
+  if (model_.scene.contact) contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
+  node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
-  if (model_.scene.contact) {
-    contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
-    // DCR treats a node with any prescribed component as immovable.
-    contact_inv_mass_.resize(n);
-    for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
-  }
   if (model_.scene.fracture_enabled()) {
     fracture_ = std::make_unique<FractureStage>(model_);
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
@@ -84,7 +118,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
   granule_sums_.assign(static_cast<size_t>(dec_->num_granules()) * kGranuleSums, 0.0);
   share_plans();
-  compute_forces();
+  compute_forces(0, 0.0);
   update_ledger();
   total0_ = ledger_.total();
   stable_dt0_ = stable_dt_;
@@ -103,7 +137,7 @@ double Simulation::next_dt() const {
   return remaining < 1.5 * dt && remaining > dt ? 0.5 * remaining : std::min(dt, remaining);
 }
 
-void Simulation::compute_forces() {
+void Simulation::compute_forces(long step, double time) {
   if (cohesive_nodes_) {
     const std::span<Vec3> arrays[] = {x_};
     timed(comm_seconds_, [&] { dec_->share(*cohesive_nodes_, arrays); });
@@ -137,7 +171,7 @@ void Simulation::compute_forces() {
       for (int a = 0; a < 4; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
     dec_->combine_granules({centre.data(), 3});
     std::ostringstream os;
-    os << "step " << step_ << ", t = " << time_ << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
+    os << "step " << step << ", t = " << time << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
        << " (body '" << (e >= 0 ? model_.scene.bodies[model_.mesh.elem_body[e]].name : "?") << "') "
        << (std::isnan(last_elements_.min_jacobian) ? "has NaN coordinates" : "is inverted") << " (det F = "
        << last_elements_.min_jacobian << ") near (" << centre.x() << ", " << centre.y() << ", " << centre.z()
@@ -193,6 +227,8 @@ void Simulation::step() {
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
+      if (model_.scene.contact->sweep_cap_fatal)
+        throw Error(sweep_cap_diagnosis(model_, x_, contact_->active_pairs(), r, step_ + 1, time_ + dt));
       if (ledger_.contact_capped_steps == 0 && !opt_.quiet && dec_->rank() == 0)
         std::fprintf(stderr, "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
                      "counted in history.csv column contact_capped_steps\n", step_ + 1, r.sweeps);
@@ -211,7 +247,7 @@ void Simulation::step() {
     granule_sums_[gr * kGranuleSums + 9] = 0;
   }
 
-  compute_forces();
+  compute_forces(step_ + 1, time_ + dt);
 
   dec_->for_touched(n, half_kick);
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
@@ -223,6 +259,7 @@ void Simulation::step() {
   ++step_;
   if (fracture_ && step_ % model_.scene.fracture_check_every == 0) apply_fracture();
   update_ledger();
+  if (!std::isfinite(ledger_.total())) throw Error(non_finite_diagnosis(model_, x_, v_, a_, ledger_, step_, time_));
 }
 
 void Simulation::apply_fracture() {
@@ -252,7 +289,7 @@ void Simulation::apply_fracture() {
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
   // unchanged).
-  if (!ins.new_nodes.empty()) compute_forces();
+  if (!ins.new_nodes.empty()) compute_forces(step_, time_);
 }
 
 void Simulation::share_plans() {
@@ -316,6 +353,21 @@ void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationSt
   if (dec_->max(failure.empty() ? 0 : 1)) throw Error(failure.empty() ? "writing the checkpoint failed on rank 0" : failure);
 }
 
+void Simulation::node_arrays_from_model() {
+  const Index n = model_.mesh.num_nodes();
+  inv_mass_.resize(n);
+  bc_nodes_.clear();
+  for (Index i = 0; i < n; ++i) {
+    inv_mass_[i] = 1.0 / model_.mass[i];
+    if (model_.bc_mask[i]) bc_nodes_.push_back(i);
+  }
+  // DCR treats a node with any prescribed component as immovable.
+  if (contact_) {
+    contact_inv_mass_.resize(n);
+    for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
+  }
+}
+
 void Simulation::save_state(SimulationState& s) const {
   s.step = step_;
   s.time = time_;
@@ -330,11 +382,30 @@ void Simulation::save_state(SimulationState& s) const {
   s.ledger = ledger_;
   s.total0 = total0_;
   s.energy_scale = energy_scale_;
+  s.model_fingerprint = model_fingerprint_;
+  s.model_nodes = model_nodes_;
+  if (fracture_) {
+    if (!s.fracture) s.fracture.emplace();
+    fracture_->save(*s.fracture);
+  } else {
+    s.fracture.reset();
+  }
 }
 
 void Simulation::restore_state(const SimulationState& s) {
-  SHATTER_REQUIRE(!fracture_, "restore_state: the state of a scene with fracture (split nodes, cohesive elements) "
-                              "cannot be restored");
+  SHATTER_REQUIRE(!fracture_ == !s.fracture, "restore_state: the state " << (s.fracture ? "has" : "has no")
+                                              << " fracture part, the scene " << (fracture_ ? "has" : "has no")
+                                              << " fracture");
+  if (fracture_) {
+    // The mesh after splits, as grow_nodes left it; bc nodes stay in node
+    // order, since split copies are appended in creation order.
+    const std::uint64_t built_revision = model_.mesh.revision;
+    fracture_->restore(*s.fracture);
+    node_arrays_from_model();
+    dec_->rebuild_nodes();
+    if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
+    share_plans();
+  }
   const size_t n = model_.mesh.num_nodes();
   SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
                       s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
@@ -522,10 +593,10 @@ long Simulation::run() {
   Progress progress(scene.end_time, opt_.quiet || !root);
   if (!restored_) write_outputs(field_every > 0);
   // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
-  // last good state when a step fails; not for scenes with fracture. On
+  // last good state when a step fails. On
   // several ranks, rank 0 writes the owners' values (save_checkpoint).
   const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
-  const bool checkpoints = !opt_.out_dir.empty() && !fracture_;
+  const bool checkpoints = !opt_.out_dir.empty();
   SimulationState good;  // the state before the current step
   auto last_checkpoint = std::chrono::steady_clock::now();
   const double tiny = 1e-12 * scene.end_time;
@@ -564,7 +635,6 @@ long Simulation::run() {
     if (stop) {
       progress.finish();
       const std::string where = checkpoints ? "; continue with --restart " + checkpoint.string()
-                                : fracture_ ? "; no checkpoint written (a scene with fracture cannot be restarted yet)"
                                             : "; no checkpoint written (no output folder)";
       throw Error("stopped by signal " + std::to_string(stop) + " after step " + std::to_string(step_) + where);
     }

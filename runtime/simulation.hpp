@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "runtime/element_forces.hpp"
+#include "runtime/fracture_stage.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {
@@ -24,7 +25,6 @@ namespace shatter {
 class FieldWriter;
 class CsvWriter;
 class ContactStage;
-class FractureStage;
 class Decomposition;
 struct SharedNodes;
 struct DecompositionStats;
@@ -51,10 +51,10 @@ struct Ledger {
   }
 };
 
-/// The complete state of a run between two steps (no fracture): what a
-/// checkpoint holds (runtime/checkpoint.hpp). Per-node arrays [n] in the
-/// model's node order; reaction [b] per node with a prescribed component, in
-/// node order.
+/// The complete state of a run between two steps: what a checkpoint holds
+/// (runtime/checkpoint.hpp). Per-node arrays [n] in the model's node order
+/// (with fracture, n counts the split copies); reaction [b] per node with a
+/// prescribed component, in node order.
 struct SimulationState {
   long step = 0;
   double time = 0, dt = 0;    ///< s: time reached, length of the last step
@@ -63,6 +63,11 @@ struct SimulationState {
   std::vector<Vec3> f_int, f_ext, reaction;  ///< N
   Ledger ledger;
   double total0 = 0, energy_scale = 0;  ///< J: energy_error()'s reference
+  std::optional<FractureState> fracture;  ///< scenes with fracture: the mesh after splits, cohesive elements
+  /// The model as built, before fracture changed its mesh: model_fingerprint()
+  /// and node count, by which a checkpoint names its model.
+  std::uint64_t model_fingerprint = 0;
+  long model_nodes = 0;
 };
 
 class Simulation {
@@ -94,14 +99,16 @@ class Simulation {
 
   /// Copies the state between two steps into `state` (reusing its storage).
   void save_state(SimulationState& state) const;
-  /// Continues from `state` (of this model, without fracture): the next
+  /// Continues from `state` (of this model): the next
   /// step() is the one the saved run would have taken, bitwise, and run()
   /// appends to the outputs in opt.out_dir (checkpoint.hpp). Throws Error when
   /// the array sizes do not match the model.
   void restore_state(const SimulationState& state);
 
  private:
-  void compute_forces();
+  /// Forces and accelerations at x_; `step` and `time` (of the configuration
+  /// x_) name it when an element is inverted.
+  void compute_forces(long step, double time);
   void update_ledger();
   void write_outputs(bool fields);
   void write_summary(double wall_seconds, const DecompositionStats& stats);
@@ -145,8 +152,11 @@ class Simulation {
   std::unique_ptr<CsvWriter> history_, bodies_;
   double stable_dt0_ = 0;  ///< stable step of the initial state (sets the default field interval)
   bool restored_ = false;  ///< restore_state() was called: run() continues the outputs
+  std::uint64_t model_fingerprint_ = 0;  ///< of the model as built (SimulationState::model_fingerprint)
+  long model_nodes_ = 0;
   void apply_fracture();
   void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
+  void node_arrays_from_model();
   void write_fragments();
   /// x and v of every node on rank 0: the own arrays on one rank, else
   /// gathered from the owners into `x` and `v` (collective).

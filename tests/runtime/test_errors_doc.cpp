@@ -1,0 +1,151 @@
+// docs/errors.md against the binary: every row of its tables that gives a
+// command is run (SCENE = the page's base scene, DIR = a folder of the bad
+// files listed on the page, made here), and the first line the binary prints
+// must be the row's message, with the row's exit status. The page is thus
+// the exact list of bad-input messages, and stays so.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "runtime/checkpoint.hpp"
+#include "runtime/model.hpp"
+#include "runtime/simulation.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Row {
+  std::string what, command, message;
+  int status = 0;
+};
+
+std::string replace_all(std::string s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+    s.replace(at, from.size(), to);
+  return s;
+}
+
+/// The text between the first pair of backticks of a table cell.
+std::string code(const std::string& cell) {
+  const size_t a = cell.find('`'), b = cell.rfind('`');
+  return a == std::string::npos || b <= a ? "" : cell.substr(a + 1, b - a - 1);
+}
+
+std::vector<std::string> cells(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (size_t i = 1; i < line.size(); ++i) {
+    if (line[i] == '\\' && i + 1 < line.size() && line[i + 1] == '|') {
+      cur += '|';
+      ++i;
+    } else if (line[i] == '|') {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += line[i];
+    }
+  }
+  return out;
+}
+
+struct Page {
+  std::string base_scene;
+  std::vector<Row> rows;
+};
+
+/// The base scene (the ```yaml block after "Base scene") and the rows
+/// | what | `command` | exit | `message` |.
+Page read_page(const fs::path& path) {
+  std::ifstream in(path);
+  Page page;
+  std::string line;
+  bool in_yaml = false, base_done = false;
+  while (std::getline(in, line)) {
+    if (!base_done && line == "```yaml") {
+      in_yaml = true;
+    } else if (in_yaml && line == "```") {
+      in_yaml = false;
+      base_done = true;
+    } else if (in_yaml) {
+      page.base_scene += line + "\n";
+    } else if (line.rfind("| ", 0) == 0) {
+      const std::vector<std::string> c = cells(line);
+      if (c.size() != 4 || code(c[1]).rfind("shatter ", 0) != 0) continue;
+      page.rows.push_back({c[0], code(c[1]), code(c[3]), std::stoi(c[2])});
+    }
+  }
+  return page;
+}
+
+/// The bad files the page's rows refer to as DIR/...
+void write_bad_files(const fs::path& dir, const std::string& base_scene) {
+  const std::string header = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  std::ofstream(dir / "inverted.msh") << header
+                                      << "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0 0 -1\n$EndNodes\n"
+                                         "$Elements\n2\n1 4 2 1 1 1 2 3 4\n42 4 2 1 1 2 3 1 5\n$EndElements\n";
+  std::ofstream(dir / "flat.msh") << header
+                                  << "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n$EndNodes\n"
+                                     "$Elements\n1\n7 4 2 1 1 1 2 3 4\n$EndElements\n";
+  std::ofstream(dir / "unused_node.msh") << header
+                                         << "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n9 5 5 5\n$EndNodes\n"
+                                            "$Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n";
+  std::ofstream(dir / "triangles.msh") << header
+                                       << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                                          "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
+  std::ofstream(dir / "mixed.msh")
+      << header
+      << "$Nodes\n14\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 0 0\n6 3 0 0\n7 2 1 0\n8 2 0 1\n"
+         "9 2.5 0 0\n10 2.5 0.5 0\n11 2 0.5 0\n12 2 0 0.5\n13 2 0.5 0.5\n14 2.5 0 0.5\n$EndNodes\n"
+         "$Elements\n2\n1 4 2 1 1 1 2 3 4\n2 11 2 1 1 5 6 7 8 9 10 11 12 13 14\n$EndElements\n";
+  std::ofstream(dir / "garbage.msh") << "this is not a mesh\n";
+  std::ofstream(dir / "bad_yaml.yaml") << "name: x\ntime: [1, 2\n";
+  std::ofstream(dir / "list.yaml") << "- name: x\n- time: 1\n";
+  std::ofstream(dir / "not_hdf5.h5") << "this is not a checkpoint\n";
+  // A checkpoint of another scene over the same mesh.
+  std::ofstream(dir / "other.yaml") << replace_all(base_scene, "name: good", "name: other");
+  shatter::Model model = shatter::build_model(shatter::load_scene((dir / "other.yaml").string()));
+  shatter::Simulation sim(model, {});
+  shatter::SimulationState state;
+  sim.save_state(state);
+  shatter::write_checkpoint(dir / "other.h5", model, state);
+}
+
+/// Exit status and first output line of `shatter args` (stdout and stderr).
+std::pair<int, std::string> run_shatter(const std::string& args) {
+  const std::string cmd = std::string(SHATTER_BINARY_DIR) + "/apps/" + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out.substr(0, out.find('\n'))};
+}
+
+}  // namespace
+
+TEST(ErrorsDoc, EveryMessageIsTheBinarys) {
+  const Page page = read_page(fs::path(SHATTER_SOURCE_DIR) / "docs" / "errors.md");
+  ASSERT_FALSE(page.base_scene.empty()) << "docs/errors.md has no ```yaml base scene";
+  ASSERT_GT(page.rows.size(), 30u);
+  const fs::path dir = fs::temp_directory_path() / "shatter_errors_doc";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.yaml") << page.base_scene;
+  write_bad_files(dir, page.base_scene);
+  const auto [good_status, good_line] = run_shatter("shatter check " + (dir / "scene.yaml").string());
+  ASSERT_EQ(good_status, 0) << "the base scene must be good: " << good_line;
+  for (const Row& row : page.rows) {
+    const auto expand = [&](const std::string& s) {
+      return replace_all(replace_all(s, "SCENE", "DIR/scene.yaml"), "DIR", dir.string());
+    };
+    const auto [status, line] = run_shatter(expand(row.command));
+    EXPECT_EQ(status, row.status) << row.what << ": " << row.command;
+    EXPECT_EQ(line, expand(row.message)) << row.what << ": " << row.command;
+  }
+}
