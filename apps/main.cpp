@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "run a scene");
   run->add_option("scene", scene_path, "scene file (YAML)")->required();
   run->add_option("--out", out_dir, "output folder (default out/<name>)");
-  run->add_option("--threads", threads, "oneTBB threads per rank")->check(CLI::PositiveNumber);
+  run->add_option("--threads", threads, "oneTBB threads per rank")->check(CLI::Range(1, 4096));
   run->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
   run->add_flag("--deterministic", deterministic, "bitwise identical results for any ranks and threads");
   run->add_option("--restart", restart, "continue from a checkpoint");
@@ -112,7 +112,9 @@ int main(int argc, char** argv) {
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-      const int rc = app.exit(e);
+      // --help and --version exit 0 through CLI11; a bad command line is bad input.
+      const int rc = e.get_exit_code() == 0 ? app.exit(e) : 2;
+      if (rc != 0 && rank == 0) std::fprintf(stderr, "error: %s (shatter --help shows the usage)\n", e.what());
       MPI_Finalize();
       return rc == 0 ? 0 : 2;
     }

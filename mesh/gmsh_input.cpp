@@ -2,6 +2,7 @@
 
 #include <gmsh.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
@@ -169,6 +170,17 @@ Mesh read_msh(const std::string& path, const std::string& physical, int body, in
     throw InputError(where + ": '" + path + "' holds no tetrahedra (expected 4- or 10-node tets)");
   if (!t4.empty() && !t10.empty())
     throw InputError(where + ": '" + path + "' mixes 4- and 10-node tetrahedra; expected one order");
+  // Gmsh 4.8 lists the tets of a volume by the type of its first one: a
+  // volume holding both orders comes back as one type, with node lists cut
+  // or overrun (found by tests/fuzz). Each element's own type tells.
+  for (const std::size_t tag : t4.empty() ? t10 : t4) {
+    int type = 0;
+    std::vector<std::size_t> nodes;
+    gmsh::model::mesh::getElement(tag, type, nodes);
+    if (type != (t4.empty() ? 11 : 4))
+      throw InputError(where + ": '" + path + "' mixes 4- and 10-node tetrahedra (element " + std::to_string(tag) +
+                       " in one volume with others); expected one order");
+  }
   return extract_tets(t4.empty() ? 2 : 1, body, material, physical, where);
 }
 

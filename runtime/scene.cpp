@@ -23,8 +23,10 @@ class Reader {
     std::ostringstream os;
     os << file_ << ": " << key << ": expected " << expected;
     if (got.IsDefined() && !got.IsNull()) {
-      YAML::Emitter e;
-      e << YAML::Flow << got;
+      YAML::Emitter e;  // one line: flow style all the way down
+      e.SetMapFormat(YAML::Flow);
+      e.SetSeqFormat(YAML::Flow);
+      e << got;
       os << ", got '" << e.c_str() << "'";
     } else {
       os << ", but it is missing";
