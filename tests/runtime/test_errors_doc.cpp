@@ -95,11 +95,6 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
   std::ofstream(dir / "triangles.msh") << header
                                        << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
                                           "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
-  std::ofstream(dir / "mixed_one_volume.msh")
-      << header
-      << "$Nodes\n14\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 0 0\n6 3 0 0\n7 2 1 0\n8 2 0 1\n"
-         "9 2.5 0 0\n10 2.5 0.5 0\n11 2 0.5 0\n12 2 0 0.5\n13 2 0.5 0.5\n14 2.5 0 0.5\n$EndNodes\n"
-         "$Elements\n2\n2 11 2 1 1 5 6 7 8 9 10 11 12 13 14\n3 4 2 1 1 1 2 3 4\n$EndElements\n";
   std::ofstream(dir / "garbage.msh") << "this is not a mesh\n";
   std::ofstream(dir / "bad_yaml.yaml") << "name: x\ntime: [1, 2\n";
   std::ofstream(dir / "list.yaml") << "- name: x\n- time: 1\n";
