@@ -367,7 +367,7 @@ TEST(Checkpoint, FractureStateMustMatchTheScene) {
   checkpoint_after("ckpt_fracture", free_scene("ckpt_fracture"), 3, file);
   std::string yaml = free_scene("ckpt_fracture");
   yaml.replace(yaml.find("poisson_ratio: 0.3}"), 19,
-               "poisson_ratio: 0.3, fracture: {strength: 1.0e9, energy: 100.0}}");
+               "poisson_ratio: 0.3, fracture: {strength: 1.0e9, energy: 1.0e4}}");
   Model model = build_model(scene_from_text("ckpt_fracture", yaml));
   const std::string why = refusal(file, model);
   EXPECT_NE(why.find("the scene has fracture but the checkpoint has no fracture state"), std::string::npos)
