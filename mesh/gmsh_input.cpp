@@ -102,6 +102,12 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
   GmshSession session;
   gmsh::model::add("shape");
   const Vec3 axis = s.axis.normalized();
+  // Volume `outer` minus volume `inner` (OCC boolean): tubes and hollow spheres.
+  auto cut = [](int outer, int inner) {
+    gmsh::vectorpair out;
+    std::vector<gmsh::vectorpair> map;
+    gmsh::model::occ::cut({{3, outer}}, {{3, inner}}, out, map);
+  };
   if (s.shape == "box") {
     const Vec3 lo = s.center - 0.5 * s.size;
     const int box = gmsh::model::occ::addBox(lo.x(), lo.y(), lo.z(), s.size.x(), s.size.y(), s.size.z());
@@ -123,17 +129,15 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
     const Vec3 d = s.length * axis;
     gmsh::model::occ::addCylinder(base.x(), base.y(), base.z(), d.x(), d.y(), d.z(), s.radius);
   } else if (s.shape == "sphere") {
-    gmsh::model::occ::addSphere(s.center.x(), s.center.y(), s.center.z(), s.radius);
+    const int outer = gmsh::model::occ::addSphere(s.center.x(), s.center.y(), s.center.z(), s.radius);
+    if (s.inner_radius > 0)
+      cut(outer, gmsh::model::occ::addSphere(s.center.x(), s.center.y(), s.center.z(), s.inner_radius));
   } else if (s.shape == "tube") {
     const Vec3 base = s.center - 0.5 * s.length * axis;
     const Vec3 d = s.length * axis;
     const int outer = gmsh::model::occ::addCylinder(base.x(), base.y(), base.z(), d.x(), d.y(), d.z(),
                                                     s.outer_radius);
-    const int inner = gmsh::model::occ::addCylinder(base.x(), base.y(), base.z(), d.x(), d.y(), d.z(),
-                                                    s.inner_radius);
-    gmsh::vectorpair out;
-    std::vector<gmsh::vectorpair> map;
-    gmsh::model::occ::cut({{3, outer}}, {{3, inner}}, out, map);
+    cut(outer, gmsh::model::occ::addCylinder(base.x(), base.y(), base.z(), d.x(), d.y(), d.z(), s.inner_radius));
   } else {
     throw InputError(where + ".shape: expected one of box, cylinder, sphere, tube; got '" + s.shape + "'");
   }

@@ -12,7 +12,7 @@ struct ShapeSpec {
   std::string shape;               ///< box | cylinder | sphere | tube
   Vec3 size = Vec3::Zero();        ///< box edge lengths
   double radius = 0;               ///< cylinder, sphere
-  double inner_radius = 0;         ///< tube
+  double inner_radius = 0;         ///< tube; sphere: > 0 makes it hollow (sphere minus sphere)
   double outer_radius = 0;         ///< tube
   double length = 0;               ///< cylinder, tube
   Vec3 center = Vec3::Zero();      ///< centre of the shape

@@ -154,9 +154,14 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
     if (s.shape == "cylinder")
       r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size", "order"});
     else
-      r.only_keys(m, key, {"shape", "radius", "center", "element_size", "order"});
+      r.only_keys(m, key, {"shape", "radius", "inner_radius", "center", "element_size", "order"});
     s.radius = r.positive(r.required(m, key, "radius"), key + ".radius");
     if (s.shape == "cylinder") s.length = r.positive(r.required(m, key, "length"), key + ".length");
+    if (s.shape == "sphere" && m["inner_radius"]) {
+      s.inner_radius = r.positive(m["inner_radius"], key + ".inner_radius");
+      if (s.inner_radius >= s.radius)
+        r.fail(key + ".inner_radius", "a value smaller than radius (a hollow sphere)", m["inner_radius"]);
+    }
   } else if (s.shape == "tube") {
     r.only_keys(m, key, {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order"});
     s.inner_radius = r.positive(r.required(m, key, "inner_radius"), key + ".inner_radius");

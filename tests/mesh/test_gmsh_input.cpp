@@ -62,7 +62,7 @@ TEST(GmshInput, CylinderTet10VolumeConverges) {
   for (int b : m.elem_body) EXPECT_EQ(b, 1);
 }
 
-TEST(GmshInput, SphereAndTubeVolumes) {
+TEST(GmshInput, SphereTubeAndHollowSphereVolumes) {
   ShapeSpec s;
   s.shape = "sphere";
   s.radius = 1.0;
@@ -75,6 +75,13 @@ TEST(GmshInput, SphereAndTubeVolumes) {
   t.length = 0.5;
   t.element_size = 0.1;
   EXPECT_CLOSE(total_volume(mesh_shape(t, 0, 0, "t")), std::numbers::pi * (1.0 - 0.64) * 0.5, 0.02, 0);
+  // Hollow sphere (sphere minus sphere): the shell volume, and no node inside the cavity.
+  ShapeSpec h = s;
+  h.inner_radius = 0.8;
+  h.element_size = 0.1;
+  const Mesh hm = mesh_shape(h, 0, 0, "t");
+  EXPECT_CLOSE(total_volume(hm), 4.0 / 3.0 * std::numbers::pi * (1.0 - 0.512), 0.02, 0);
+  for (const Vec3& x : hm.reference) EXPECT_GT(x.norm(), 0.8 * (1 - 1e-3));
 }
 
 TEST(GmshInput, MshFileRoundTripV2AndV4) {
