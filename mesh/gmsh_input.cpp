@@ -102,11 +102,13 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
   GmshSession session;
   gmsh::model::add("shape");
   const Vec3 axis = s.axis.normalized();
-  // Volume `outer` minus volume `inner` (OCC boolean): tubes and hollow spheres.
+  // Volume `outer` minus volume `inner` (OCC boolean): notched boxes, tubes, hollow
+  // spheres. Returns the resulting volumes.
   auto cut = [](int outer, int inner) {
     gmsh::vectorpair out;
     std::vector<gmsh::vectorpair> map;
     gmsh::model::occ::cut({{3, outer}}, {{3, inner}}, out, map);
+    return out;
   };
   if (s.shape == "box") {
     const Vec3 lo = s.center - 0.5 * s.size;
@@ -115,9 +117,7 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
       const Vec3 nlo = s.notch_center - 0.5 * s.notch_size;
       const int notch = gmsh::model::occ::addBox(nlo.x(), nlo.y(), nlo.z(), s.notch_size.x(), s.notch_size.y(),
                                                  s.notch_size.z());
-      gmsh::vectorpair out;
-      std::vector<gmsh::vectorpair> map;
-      gmsh::model::occ::cut({{3, box}}, {{3, notch}}, out, map);
+      const gmsh::vectorpair out = cut(box, notch);
       const double volume = s.size.prod();
       double mass = 0;
       if (out.size() == 1) gmsh::model::occ::getMass(3, out[0].second, mass);
