@@ -10,18 +10,6 @@
 namespace shatter {
 namespace {
 
-/// Flatten (rank, local node) pairs, each rank's nodes already ascending,
-/// into a NodeExchange.
-NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank) {
-  NodeExchange x;
-  for (const auto& [q, nodes] : by_rank) {
-    x.ranks.push_back(q);
-    x.nodes.insert(x.nodes.end(), nodes.begin(), nodes.end());
-    x.offsets.push_back(static_cast<Index>(x.nodes.size()));
-  }
-  return x;
-}
-
 /// Indices 0..n-1 sorted by gid[i]; throws on a repeated gid.
 std::vector<Index> order_by_gid(const std::vector<Index>& items, const std::vector<GlobalId>& gid,
                                 const char* what) {
@@ -35,6 +23,16 @@ std::vector<Index> order_by_gid(const std::vector<Index>& items, const std::vect
 }
 
 }  // namespace
+
+NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank) {
+  NodeExchange x;
+  for (const auto& [q, nodes] : by_rank) {
+    x.ranks.push_back(q);
+    x.nodes.insert(x.nodes.end(), nodes.begin(), nodes.end());
+    x.offsets.push_back(static_cast<Index>(x.nodes.size()));
+  }
+  return x;
+}
 
 NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part) {
   NodeRanks t;

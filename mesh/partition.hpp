@@ -3,6 +3,7 @@
 // of the element dual graph, and the part of the mesh one rank holds — its
 // owned elements plus one ghost layer — with the node lists it exchanges.
 #include <cstdint>
+#include <map>
 #include <span>
 #include <vector>
 
@@ -57,6 +58,9 @@ struct NodeExchange {
     return {nodes.data() + offsets[i], static_cast<size_t>(offsets[i + 1] - offsets[i])};
   }
 };
+
+/// Flatten nodes grouped by rank (each group ascending) into a NodeExchange.
+NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank);
 
 /// The part of a global mesh that rank `rank` holds.
 ///

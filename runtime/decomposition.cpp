@@ -12,16 +12,6 @@
 namespace shatter {
 namespace {
 
-NodeExchange exchange_from(const std::map<int, std::vector<Index>>& by_rank) {
-  NodeExchange x;
-  for (const auto& [q, nodes] : by_rank) {
-    x.ranks.push_back(q);
-    x.nodes.insert(x.nodes.end(), nodes.begin(), nodes.end());
-    x.offsets.push_back(static_cast<Index>(x.nodes.size()));
-  }
-  return x;
-}
-
 /// This rank's values of the plan's nodes it owns, interleaved: node-major, then array, then component.
 std::vector<double> pack(const SharedNodes& plan, int rank, std::span<const std::span<Vec3>> arrays) {
   const size_t m = 3 * arrays.size(), first = plan.displacements[rank];
