@@ -33,7 +33,7 @@ struct ContactSurface {
   std::vector<std::array<Index, 3>> triangles;
   std::vector<int> body;
   std::vector<std::array<Index, 2>> edges;
-  std::vector<Index> vertices;
+  std::vector<Index> vertices;  ///< ascending, distinct
 
   Index num_triangles() const { return static_cast<Index>(triangles.size()); }
   Index num_edges() const { return static_cast<Index>(edges.size()); }

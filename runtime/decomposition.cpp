@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <string>
 
 #include "kernels/error.hpp"
@@ -78,12 +79,8 @@ void Decomposition::rebuild_nodes() {
   const Index ng = num_granules();
 
   // Home granule of each node: the granule of the first element of its star.
-  home_granule_.assign(nn, -1);
-  for (Index e = 0; e < ne; ++e)
-    for (int a = 0; a < k; ++a) {
-      Index& h = home_granule_[mesh.element(e)[a]];
-      if (h < 0) h = e / ElementForces::kGranule;
-    }
+  home_granule_.resize(nn);
+  for (Index n = 0; n < nn; ++n) home_granule_[n] = mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule;
   home_offsets_.assign(ng + 1, 0);
   for (Index n = 0; n < nn; ++n) ++home_offsets_[home_granule_[n] + 1];
   for (Index g = 0; g < ng; ++g) home_offsets_[g + 1] += home_offsets_[g];
@@ -93,6 +90,15 @@ void Decomposition::rebuild_nodes() {
     for (Index n = 0; n < nn; ++n) home_nodes_[fill[home_granule_[n]]++] = n;
   }
 
+  if (size_ == 1) {
+    // One rank touches, holds and owns everything.
+    touched_nodes_.resize(nn);
+    std::iota(touched_nodes_.begin(), touched_nodes_.end(), 0);
+    held_nodes_ = touched_nodes_;
+    local_elements_.resize(ne);
+    std::iota(local_elements_.begin(), local_elements_.end(), 0);
+    return;
+  }
   std::vector<int> elem_part(ne);
   for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[e / ElementForces::kGranule];
   NodeRanks touch = touching_ranks(mesh, elem_part);
@@ -119,33 +125,31 @@ void Decomposition::rebuild_nodes() {
   for (Index n = 0; n < nn; ++n)
     if (held[n]) held_nodes_.push_back(n);
 
-  if (size_ > 1) {
-    // Receive: ghost-only nodes (held, not touched) from their owners.
-    std::map<int, std::vector<Index>> recv, send;
-    for (Index n : held_nodes_)
-      if (!touches(n, rank_)) recv[node_owner(n)].push_back(n);
-    // Send: nodes owned here to every rank holding them without touching
-    // them. Rank q holds n when it touches a node of an element of n's star.
-    std::vector<int> holders;
-    for (Index n : touched_nodes_) {
-      if (node_owner(n) != rank_) continue;
-      holders.clear();
-      for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p) {
-        const Index* c = mesh.element(mesh.node_elem[p]);
-        for (int a = 0; a < k; ++a)
-          for (Index q = node_rank_offsets_[c[a]]; q < node_rank_offsets_[c[a] + 1]; ++q)
-            holders.push_back(node_ranks_[q]);
-      }
-      std::sort(holders.begin(), holders.end());
-      holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
-      for (int q : holders)
-        if (!touches(n, q)) send[q].push_back(n);
+  // Receive: ghost-only nodes (held, not touched) from their owners.
+  std::map<int, std::vector<Index>> recv, send;
+  for (Index n : held_nodes_)
+    if (!touches(n, rank_)) recv[node_owner(n)].push_back(n);
+  // Send: nodes owned here to every rank holding them without touching
+  // them. Rank q holds n when it touches a node of an element of n's star.
+  std::vector<int> holders;
+  for (Index n : touched_nodes_) {
+    if (node_owner(n) != rank_) continue;
+    holders.clear();
+    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p) {
+      const Index* c = mesh.element(mesh.node_elem[p]);
+      for (int a = 0; a < k; ++a)
+        for (Index q = node_rank_offsets_[c[a]]; q < node_rank_offsets_[c[a] + 1]; ++q)
+          holders.push_back(node_ranks_[q]);
     }
-    halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_);
-    std::vector<Index> all(nn);
-    for (Index n = 0; n < nn; ++n) all[n] = n;
-    all_nodes_ = shared_nodes(std::move(all));
+    std::sort(holders.begin(), holders.end());
+    holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
+    for (int q : holders)
+      if (!touches(n, q)) send[q].push_back(n);
   }
+  halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_);
+  std::vector<Index> all(nn);
+  std::iota(all.begin(), all.end(), 0);
+  all_nodes_ = shared_nodes(std::move(all));
 }
 
 void Decomposition::update_ghost_only(std::span<Vec3> x) const {

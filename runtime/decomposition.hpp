@@ -25,8 +25,6 @@
 // the same bits as a serial run, for any decomposition.
 // With one rank (or MPI not initialised) nothing is communicated.
 #include <mpi.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <memory>
 #include <span>
@@ -34,6 +32,7 @@
 
 #include "kernels/types.hpp"
 #include "runtime/model.hpp"
+#include "runtime/parallel.hpp"
 
 namespace shatter {
 
@@ -89,7 +88,7 @@ class Decomposition {
   }
   Index home_granule(Index node) const { return home_granule_[node]; }
   /// The smallest rank touching the node.
-  int node_owner(Index node) const { return node_ranks_[node_rank_offsets_[node]]; }
+  int node_owner(Index node) const { return size_ == 1 ? 0 : node_ranks_[node_rank_offsets_[node]]; }
   Index owned_elements() const { return owned_elements_; }
 
   /// Apply body(i) to every touched node, in parallel (all nodes on 1 rank).
@@ -128,7 +127,7 @@ class Decomposition {
   std::vector<Index> owned_granules_;
   Index owned_elements_ = 0;
   std::vector<Index> node_rank_offsets_;
-  std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending
+  std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending (empty on one rank)
   std::vector<Index> local_elements_, held_nodes_, touched_nodes_;
   std::vector<Index> home_granule_, home_offsets_, home_nodes_;
   std::unique_ptr<Halo> halo_;
@@ -137,16 +136,8 @@ class Decomposition {
 
 template <class Body>
 void Decomposition::for_touched(Index num_nodes, Body body) const {
-  if (!distributed()) {
-    tbb::parallel_for(tbb::blocked_range<Index>(0, num_nodes, 1024), [&](const tbb::blocked_range<Index>& r) {
-      for (Index i = r.begin(); i < r.end(); ++i) body(i);
-    });
-  } else {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, touched_nodes_.size(), 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t k = r.begin(); k < r.end(); ++k) body(touched_nodes_[k]);
-                      });
-  }
+  if (!distributed()) return parallel_for_each(num_nodes, body);
+  parallel_for_each(static_cast<Index>(touched_nodes_.size()), [&](Index k) { body(touched_nodes_[k]); });
 }
 
 }  // namespace shatter

@@ -92,16 +92,16 @@ Simulation::Simulation(Model& model, RunOptions options)
       dec_(std::make_unique<Decomposition>(model, opt_.ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF)),
       elements_(model) {
   const Mesh& mesh = model_.mesh;
+  model_fingerprint_ = model_fingerprint(model_);
   if (dec_->distributed()) {
     // Every rank meshed the scene itself: check that they agree.
-    std::uint64_t fp[2] = {model_fingerprint(model_), ~model_fingerprint(model_)};
+    std::uint64_t fp[2] = {model_fingerprint_, ~model_fingerprint_};
     MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, dec_->comm());
     if (fp[0] != ~fp[1])
       throw Error(model_.scene.file + ": the MPI ranks built different models from the scene (meshing differs "
                   "between processes)");
   }
   const Index n = mesh.num_nodes();
-  model_fingerprint_ = model_fingerprint(model_);
   model_nodes_ = n;
   x_ = mesh.reference;
   v_ = model_.initial_velocity;
@@ -296,11 +296,7 @@ void Simulation::share_plans() {
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
   auto plan = [&](std::vector<Index> nodes) { return std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(nodes))); };
-  if (contact_) {
-    std::vector<Index> vertices(contact_->surface().vertices.begin(), contact_->surface().vertices.end());
-    std::sort(vertices.begin(), vertices.end());
-    surface_nodes_ = plan(std::move(vertices));
-  }
+  if (contact_) surface_nodes_ = plan(contact_->surface().vertices);
   if (fracture_ && fracture_->cohesive_count() > 0) cohesive_nodes_ = plan(fracture_->cohesive_nodes());
 }
 
