@@ -7,6 +7,8 @@
 // no node) in a tbb::parallel_for. Every node receives its updates in the fixed
 // order (sweep, color, pair), so results are bitwise identical for any number of
 // threads.
+#include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -31,19 +33,48 @@ struct DcrResult {
   double dissipated = 0.0;  ///< kinetic energy lost by the impacts and friction, J
   bool capped = false;      ///< max_sweeps reached with penetrations still being resolved
   Index unresolved = -1;    ///< when capped: the first pair (in pair order) still penetrating in the last sweep
+  int exchanges = 0;        ///< DcrRemote::exchange calls
 };
 
 /// Pairs grouped by color, as built by greedy_coloring (runtime/coloring.hpp) over the
 /// CSR of contact_pair_nodes: the pairs of color k are items[offsets[k] .. offsets[k+1]),
 /// and no two of them share a node. Every pair index appears exactly once.
+/// slots: the CSR's compact node numbers (four per pair), num_slots of them, so that the
+/// sweeps' per-node bookkeeping is sized by the pairs' nodes, not by the mesh.
 struct DcrPairColors {
   std::span<const Index> offsets;
   std::span<const Index> items;
+  std::span<const Index> slots;
+  Index num_slots = 0;
 };
 
-/// The pair -> node CSR to color: the nodes of pair i are
-/// nodes[offsets[i] .. offsets[i+1]) (four per pair, in ContactPair::nodes order).
-void contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, std::vector<Index>& nodes);
+/// The pair -> node CSR to color, the nodes numbered compactly: pair i's nodes are
+/// slots[offsets[i] .. offsets[i+1]) (four per pair, in ContactPair::nodes order), a node's
+/// slot being its index among the pairs' distinct nodes in order of first appearance.
+/// node_slot: scratch indexed by node id (larger than every node of the pairs) holding -1,
+/// and left so: the cost is O(pairs), whatever the mesh size. Returns the number of slots.
+Index contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, std::vector<Index>& slots,
+                         std::vector<Index>& node_slot);
+
+/// The pairs resolved elsewhere (other MPI ranks: runtime/contact_stage.cpp). Pair i belongs
+/// to rank owner[i]; resolve_contacts resolves the pairs of `rank` and hands the ones it found
+/// penetrating (in sweep, color, pair order) with their dissipation in that sweep to exchange,
+/// which must write x_new and v of the nodes of the pairs found penetrating elsewhere since the
+/// last exchange and list them (in the order of their rank's list, ranks in turn) with their
+/// dissipation in `there`. An exchange is made at the end of each sweep and before every color
+/// with a pair whose node a pair of another rank touched since the last exchange (a schedule the
+/// same on every rank, from the coloring and owner only). The pairs of one color share no node,
+/// so each pair reads the states the serial sweeps would give it: the result is the serial one
+/// bit for bit, on every rank.
+struct DcrRemote {
+  struct Moves {
+    std::vector<Index> pairs;
+    std::vector<double> dissipated;
+  };
+  std::span<const int> owner;
+  int rank = 0;
+  std::function<void(const Moves& here, Moves& there)> exchange;
+};
 
 /// Resolves the penetrations of one step (DESIGN.md step 2). Nodal arrays are indexed by
 /// the local node ids of the pairs:
@@ -55,9 +86,11 @@ void contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, 
 /// Each sweep re-checks every pair (dcr_detect) and resolves the penetrating ones
 /// (dcr_project, dcr_impulse); sweeps repeat until one finds no penetration or
 /// options.max_sweeps is reached. Pairs whose four nodes are not distinct are skipped.
-/// Run inside the caller's tbb::task_arena to choose the thread count.
+/// Run inside the caller's tbb::task_arena to choose the thread count. With `remote`, only
+/// the pairs of remote->rank are resolved here (above); the result is the same on every rank.
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std::span<const Vec3> x_old,
                            std::span<Vec3> v, std::span<const double> inv_mass, double dt,
-                           const DcrOptions& options, const DcrPairColors& colors);
+                           const DcrOptions& options, const DcrPairColors& colors,
+                           const DcrRemote* remote = nullptr);
 
 }  // namespace shatter

@@ -13,6 +13,18 @@
 // the list with the step's own box test (pair_boxes_overlap) gives exactly
 // the pairs a fresh search would: DCR sees the same list, in the same order,
 // whatever the reuse schedule (restarts stay bitwise).
+//
+// On several MPI ranks (docs/parallel.md "Contact across ranks") every rank
+// holds the surface state (the caller shares it) and runs the search; the
+// surface primitives are partitioned by RCB (ContactPartition) and a pair
+// belongs to the rank of its face (vertex-face) or first edge (edge-edge).
+// Each rank filters its own candidates, the step's pairs are gathered in the
+// canonical order and colored on every rank, and each rank resolves its own
+// pairs of a color before the moved nodes' states are exchanged for the next
+// one (DcrRemote): every rank ends with the serial bits of every surface node.
+#include <array>
+#include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -22,9 +34,34 @@
 
 namespace shatter {
 
+/// Where the contact stage spends its time and how much work it finds, summed
+/// over the steps (summary.json, docs/scenes.md).
+struct ContactProfile {
+  double verlet_seconds = 0;    ///< checking that the candidates of the last search still serve
+  double search_seconds = 0;    ///< the searches themselves
+  double filter_seconds = 0;    ///< the step's box test over the candidates
+  double coloring_seconds = 0;  ///< node slots and the coloring of the step's pairs
+  double sweep_seconds = 0;     ///< the DCR sweeps
+  long steps = 0, searches = 0;
+  long candidates = 0;    ///< candidates of the search in force, summed over steps
+  long active_pairs = 0;  ///< pairs DCR checked, summed over steps
+  long colors = 0, sweeps = 0;
+  // On several ranks:
+  long owned_pairs = 0;      ///< pairs resolved here, summed over steps
+  long exchange_bytes = 0;   ///< bytes this rank sent for the step's pairs and DCR moves
+  double exchange_seconds = 0;  ///< in those exchanges (not in the times above)
+  long repartitions = 0;     ///< RCB partitions computed
+  long exchanges = 0;        ///< DCR exchanges (DcrRemote)
+};
+
+class Decomposition;
+class ContactPartition;
+
 class ContactStage {
  public:
-  ContactStage(const Model& model, const ContactSpec& spec);
+  /// dec: the ranks sharing the work (null or one rank: all pairs resolved here).
+  ContactStage(const Model& model, const ContactSpec& spec, const Decomposition* dec = nullptr);
+  ~ContactStage();
 
   /// Find the pairs penetrating during the motion x_old -> x_new and resolve
   /// them: x_new is projected back, v (the mid-step velocity) gets the DCR
@@ -39,10 +76,14 @@ class ContactStage {
   const ContactSurface& surface() const { return surface_; }
   /// The pairs DCR checked in the last apply() (equal to a fresh search's).
   const ContactPairs& active_pairs() const { return active_; }
-  /// Seconds spent in the search and in DCR so far; number of searches run.
-  double search_seconds() const { return search_seconds_; }
-  double dcr_seconds() const { return dcr_seconds_; }
-  long searches() const { return searches_; }
+  /// Seconds spent in the search (the reuse check and the step's filter
+  /// included) and in DCR (coloring and sweeps) so far; number of searches run.
+  double search_seconds() const { return profile_.verlet_seconds + profile_.search_seconds + profile_.filter_seconds; }
+  double dcr_seconds() const { return profile_.coloring_seconds + profile_.sweep_seconds; }
+  long searches() const { return profile_.searches; }
+  const ContactProfile& profile() const { return profile_; }
+  /// Smallest and largest profile().owned_pairs over the ranks (collective).
+  std::array<long, 2> owned_pairs_range() const;
   /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
   /// median surface edge length.
   double margin() const { return margin_; }
@@ -50,6 +91,10 @@ class ContactStage {
  private:
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   void search(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
+  /// Ranks of the new candidates; a new RCB partition when needed (the rule in contact_stage.cpp).
+  void assign_pairs(std::span<const Vec3> x);
+  /// The step's pairs: this rank's candidates that pass the box test, gathered from every rank.
+  void gather_active(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
 
   ContactSurface surface_;
   DcrOptions options_;
@@ -59,9 +104,18 @@ class ContactStage {
   ContactPairs pairs_;   ///< candidates of the last search (inflated boxes)
   ContactPairs active_;  ///< this step's pairs: pairs_ whose swept boxes overlap
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
-  std::vector<Index> pair_offsets_, pair_nodes_;
-  double search_seconds_ = 0, dcr_seconds_ = 0;
-  long searches_ = 0;
+  std::vector<Index> pair_offsets_, pair_slots_;
+  std::vector<Index> node_slot_;  ///< contact_pair_nodes' scratch, -1 per mesh node
+  ContactProfile profile_;
+  // Several ranks:
+  const Decomposition* dec_ = nullptr;  ///< null on one rank
+  std::unique_ptr<ContactPartition> partition_;
+  std::vector<Index> triangle_order_;  ///< triangles sorted by their nodes (pair -> face)
+  std::vector<int> primitive_rank_;    ///< rank of each triangle, then of each edge
+  bool repartition_ = true;            ///< the surface changed: partition at the next search
+  std::vector<int> pair_rank_;         ///< rank of each candidate of pairs_
+  std::vector<int> active_rank_;       ///< rank of each active pair
+  std::vector<double> send_, receive_;
 };
 
 }  // namespace shatter

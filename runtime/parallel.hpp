@@ -6,6 +6,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "kernels/types.hpp"
@@ -31,6 +32,27 @@ T deterministic_sum(Index n, const T& zero, Term term) {
   T total = zero;
   for (const T& p : partial) total += p;
   return total;
+}
+
+/// The i in [0, n) with keep(i), ascending: blocks of kReduceBlock filtered
+/// in parallel and concatenated in block order (the same list for any thread count).
+template <class Keep>
+std::vector<Index> parallel_select(Index n, Keep keep) {
+  const Index blocks = (n + kReduceBlock - 1) / kReduceBlock;
+  std::vector<std::vector<Index>> partial(blocks);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, blocks), [&](const tbb::blocked_range<Index>& r) {
+    for (Index b = r.begin(); b < r.end(); ++b) {
+      const Index end = std::min(n, (b + 1) * kReduceBlock);
+      for (Index i = b * kReduceBlock; i < end; ++i)
+        if (keep(i)) partial[b].push_back(i);
+    }
+  });
+  std::vector<Index> out;
+  size_t total = 0;
+  for (const auto& p : partial) total += p.size();
+  out.reserve(total);
+  for (const auto& p : partial) out.insert(out.end(), p.begin(), p.end());
+  return out;
 }
 
 /// Apply body(i) for i in [0, n) in parallel (no reduction; any order).

@@ -108,7 +108,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   a_.assign(n, Vec3::Zero());
   f_int_.assign(n, Vec3::Zero());
   f_ext_.assign(n, Vec3::Zero());
-  if (model_.scene.contact) contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact);
+  if (model_.scene.contact) contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
   if (model_.scene.fracture_enabled()) {
@@ -641,7 +641,8 @@ long Simulation::run() {
   if (!opt_.out_dir.empty()) {
     if (fracture_) write_fragments();
     const DecompositionStats stats = dec_->stats();
-    if (root) write_summary(wall, stats);
+    const std::array<long, 2> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 2>{};
+    if (root) write_summary(wall, stats, pairs);
   }
   return step_;
 }
@@ -661,7 +662,7 @@ void Simulation::write_fragments() {
   }
 }
 
-void Simulation::write_summary(double wall, const DecompositionStats& stats) {
+void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 2> owned_pairs) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -686,7 +687,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats) {
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
   j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
   j.add("granule_sum_bytes_per_step", static_cast<long>(dec_->distributed() ? 8 * granule_sums_.size() : 0));
-  j.add("communication_time", comm_seconds_);
+  // The contact stage's exchanges included (contact_exchange_time).
+  j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
   j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
   j.add("elements", static_cast<long>(model_.mesh.num_elements()));
   j.add("element_order", model_.mesh.order);
@@ -719,6 +721,25 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats) {
     j.add("contact_searches", contact_->searches());
     j.add("contact_dcr_time", contact_->dcr_seconds());
     j.add("contact_surface_triangles", static_cast<long>(contact_->surface().num_triangles()));
+    // The split of the two times above and the work per step (docs/scenes.md).
+    const ContactProfile& cp = contact_->profile();
+    const double steps = std::max(1L, cp.steps);
+    j.add("contact_verlet_time", cp.verlet_seconds);
+    j.add("contact_filter_time", cp.filter_seconds);
+    j.add("contact_coloring_time", cp.coloring_seconds);
+    j.add("contact_sweep_time", cp.sweep_seconds);
+    j.add("contact_candidates_per_step", cp.candidates / steps);
+    j.add("contact_pairs_per_step", cp.active_pairs / steps);
+    j.add("contact_colors_per_step", cp.colors / steps);
+    j.add("contact_sweeps_per_step", cp.sweeps / steps);
+    if (dec_->distributed()) {
+      j.add("contact_pairs_per_step_rank_min", owned_pairs[0] / steps);
+      j.add("contact_pairs_per_step_rank_max", owned_pairs[1] / steps);
+      j.add("contact_exchange_time", cp.exchange_seconds);
+      j.add("contact_exchange_bytes_per_step", cp.exchange_bytes / steps);
+      j.add("contact_repartitions", cp.repartitions);
+      j.add("contact_exchanges_per_step", cp.exchanges / steps);
+    }
   }
   j.write(opt_.out_dir / "summary.json");
 }

@@ -195,14 +195,23 @@ int count_penetrations(const Stack& s, const std::vector<Vec3>& x) {
   return bad;
 }
 
-Coloring color_pairs(const Stack& s) {
-  std::vector<Index> offsets, nodes;
-  contact_pair_nodes(s.pairs, offsets, nodes);
-  return greedy_coloring(offsets, nodes, static_cast<Index>(s.x_old.size()));
+/// A coloring of the pairs with their compact node slots.
+struct PairColoring : Coloring {
+  std::vector<Index> slots;
+  Index num_slots = 0;
+  DcrPairColors dcr() const { return {offsets, items, slots, num_slots}; }
+};
+
+PairColoring color_pairs(const Stack& s) {
+  std::vector<Index> offsets, node_slot(s.x_old.size(), -1);
+  PairColoring c;
+  c.num_slots = contact_pair_nodes(s.pairs, offsets, c.slots, node_slot);
+  static_cast<Coloring&>(c) = greedy_coloring(offsets, c.slots, c.num_slots);
+  return c;
 }
 
-DcrResult run(Stack& s, const DcrOptions& options, const Coloring& c) {
-  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, {c.offsets, c.items});
+DcrResult run(Stack& s, const DcrOptions& options, const PairColoring& c) {
+  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, c.dcr());
 }
 
 struct Totals {
@@ -232,7 +241,7 @@ TEST_P(DcrStack, OnFixedGroundIsResolved) {
   Stack s = make_stack(5, 5, true, 1, GetParam());
   ASSERT_GT(count_penetrations(s, s.x_new), 0);
   const std::vector<Vec3> x0 = s.x_new, v0 = s.v;
-  const Coloring c = color_pairs(s);
+  const PairColoring c = color_pairs(s);
   const DcrResult r = run(s, {0.5, 0.3, 1e-6, 200}, c);
   EXPECT_FALSE(r.capped);
   EXPECT_GT(r.contacts, 0);
@@ -255,7 +264,9 @@ INSTANTIATE_TEST_SUITE_P(DcrSweep, DcrStack, ::testing::Values(false, true),
 
 TEST(DcrSweep, OnePairPerColorAlsoResolves) {
   Stack s = make_stack(4, 4, true, 2, true);
-  Coloring c;
+  PairColoring c = color_pairs(s);
+  c.offsets.clear();
+  c.items.clear();
   for (Index i = 0; i <= static_cast<Index>(s.pairs.size()); ++i) c.offsets.push_back(i);
   for (Index i = 0; i < static_cast<Index>(s.pairs.size()); ++i) c.items.push_back(i);
   const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200}, c);
@@ -310,7 +321,7 @@ TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
     s.pairs.push_back({ContactPair::VertexFace, {first, first + 1, first + 2, first + 3}});
   }
   const std::vector<Vec3> v0 = s.v;
-  const Coloring c = color_pairs(s);
+  const PairColoring c = color_pairs(s);
   EXPECT_EQ(c.num_colors(), 1);
   const DcrResult r = run(s, {1.0, 0.5, 1e-6, 10}, c);
   EXPECT_EQ(r.contacts, 50);
@@ -331,7 +342,7 @@ TEST(DcrSweep, CapIsReported) {
 
 TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
   const Stack initial = make_stack(5, 6, true, 7, true);
-  const Coloring c = color_pairs(initial);
+  const PairColoring c = color_pairs(initial);
   const tbb::global_control allow(tbb::global_control::max_allowed_parallelism, 4);  // even on fewer cores
   std::vector<Stack> runs;
   std::vector<DcrResult> results;
@@ -353,9 +364,9 @@ TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
 
 TEST(DcrSweep, RejectsInconsistentInput) {
   Stack s = make_stack(2, 2, true, 8);
-  const Coloring c = color_pairs(s);
+  const PairColoring c = color_pairs(s);
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {c.offsets, c.items}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, c.dcr()), Error);
   const std::vector<Index> no_items;
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {c.offsets, no_items}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {c.offsets, no_items, c.slots, c.num_slots}), Error);
 }

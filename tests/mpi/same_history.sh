@@ -4,7 +4,7 @@
 # "bitwise with --deterministic"; the decomposed loop is bitwise for any
 # decomposition, so the flag changes nothing). Also checks that summary.json
 # names the ranks and that the comparison covers what the scene is for:
-#   contact:  the run had contacts;
+#   contact:  the run had contacts, and at 3 ranks every rank resolved pairs;
 #   fracture: cohesive elements were inserted between elements of different
 #             ranks at 3 ranks (cracks crossing subdomain boundaries).
 # usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture [--set key=value ...]
@@ -37,6 +37,10 @@ if [ "$kind" = contact ]; then
   col=$(head -1 "$work/r1t1/history.csv" | tr ',' '\n' | grep -n '^contacts$' | cut -d: -f1)
   n=$(tail -n +2 "$work/r1t1/history.csv" | cut -d, -f"$col" | sort -n | tail -1)
   what="max contacts $n"
+  # The partitioned contact stage (docs/parallel.md) must have given pairs to every rank.
+  least=$(grep -o '"contact_pairs_per_step_rank_min": [-0-9.e+]*' "$work/r3t1/summary.json" | awk '{print $2}')
+  awk -v m="${least:-0}" 'BEGIN { exit !(m > 0) }' || { echo "FAIL: a rank of 3 resolved no contact pairs"; status=1; }
+  what="$what, at 3 ranks at least $least pairs per step per rank"
 else
   n=$(grep -o '"cohesive_elements_across_ranks": [0-9]*' "$work/r3t1/summary.json" | grep -o '[0-9]*$')
   what="$n cohesive elements across ranks at 3 ranks"
