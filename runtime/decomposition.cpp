@@ -127,8 +127,12 @@ void Decomposition::rebuild_nodes() {
 
   // Receive: ghost-only nodes (held, not touched) from their owners.
   std::map<int, std::vector<Index>> recv, send;
+  ghost_only_nodes_.clear();
   for (Index n : held_nodes_)
-    if (!touches(n, rank_)) recv[node_owner(n)].push_back(n);
+    if (!touches(n, rank_)) {
+      recv[node_owner(n)].push_back(n);
+      ghost_only_nodes_.push_back(n);
+    }
   // Send: nodes owned here to every rank holding them without touching
   // them. Rank q holds n when it touches a node of an element of n's star.
   std::vector<int> holders;
@@ -152,8 +156,12 @@ void Decomposition::rebuild_nodes() {
   all_nodes_ = shared_nodes(std::move(all));
 }
 
-void Decomposition::update_ghost_only(std::span<Vec3> x) const {
-  if (halo_) halo_->update_ghosts(x);
+void Decomposition::begin_ghost_update(std::span<const Vec3> x) const {
+  if (halo_) halo_->begin_update(x);
+}
+
+void Decomposition::end_ghost_update(std::span<Vec3> x) const {
+  if (halo_) halo_->end_update(x);
 }
 
 std::size_t Decomposition::ghost_bytes() const { return halo_ ? halo_->update_bytes(3) : 0; }

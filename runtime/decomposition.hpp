@@ -95,9 +95,14 @@ class Decomposition {
   template <class Body>
   void for_touched(Index num_nodes, Body body) const;
 
-  /// Positions of the ghost-only nodes from their owners.
-  void update_ghost_only(std::span<Vec3> x) const;
-  /// Bytes this rank sends per update_ghost_only.
+  /// Positions of the ghost-only nodes from their owners, nonblocking: begin
+  /// posts the owned values (x must not change until end), end waits and
+  /// writes the ghost-only nodes (not to be read before). No-ops on one rank.
+  void begin_ghost_update(std::span<const Vec3> x) const;
+  void end_ghost_update(std::span<Vec3> x) const;
+  /// Nodes held here but touched only by other ranks (filled by the update), ascending.
+  std::span<const Index> ghost_only_nodes() const { return ghost_only_nodes_; }
+  /// Bytes this rank sends per ghost update.
   std::size_t ghost_bytes() const;
   /// Over all ranks (collective).
   DecompositionStats stats() const;
@@ -128,7 +133,7 @@ class Decomposition {
   Index owned_elements_ = 0;
   std::vector<Index> node_rank_offsets_;
   std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending (empty on one rank)
-  std::vector<Index> local_elements_, held_nodes_, touched_nodes_;
+  std::vector<Index> local_elements_, held_nodes_, touched_nodes_, ghost_only_nodes_;
   std::vector<Index> home_granule_, home_offsets_, home_nodes_;
   std::unique_ptr<Halo> halo_;
   SharedNodes all_nodes_;

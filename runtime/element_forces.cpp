@@ -43,9 +43,22 @@ void ElementForces::rebuild() {
   subset_offsets_.resize(nblocks + 1);
   for (Index b = 0; b <= nblocks; ++b) subset_offsets_[b] = std::min(ne, b * kBlock);
   zero_nodes_.clear();
+  split_phases(std::vector<char>(nblocks, 0));
 }
 
-void ElementForces::restrict_to(std::span<const Index> elements, std::span<const Index> nodes) {
+void ElementForces::split_phases(const std::vector<char>& late) {
+  for (int p = 0; p < 2; ++p) {
+    phase_items_[p].clear();
+    phase_offsets_[p].assign(1, 0);
+  }
+  for (int c = 0; c < coloring_.num_colors(); ++c) {
+    for (const Index b : coloring_.items_of(c)) phase_items_[late[b] ? 1 : 0].push_back(b);
+    for (int p = 0; p < 2; ++p) phase_offsets_[p].push_back(static_cast<Index>(phase_items_[p].size()));
+  }
+}
+
+void ElementForces::restrict_to(std::span<const Index> elements, std::span<const Index> nodes,
+                                std::span<const Index> late_nodes) {
   const Index nblocks = static_cast<Index>(block_dt_.size());
   SHATTER_REQUIRE(!nodes.empty() || elements.empty(), "ElementForces::restrict_to: elements without nodes");
   subset_.assign(elements.begin(), elements.end());
@@ -53,10 +66,38 @@ void ElementForces::restrict_to(std::span<const Index> elements, std::span<const
   subset_offsets_.assign(nblocks + 1, 0);
   for (Index e : subset_) ++subset_offsets_[e / kBlock + 1];
   for (Index b = 0; b < nblocks; ++b) subset_offsets_[b + 1] += subset_offsets_[b];
+
+  // Late blocks: those reading a late node, then closed under the color order.
+  const Mesh& mesh = model_.mesh;
+  const int k = mesh.nodes_per_element();
+  auto for_nodes = [&](Index b, auto f) {
+    for (Index i = subset_offsets_[b]; i < subset_offsets_[b + 1]; ++i)
+      for (int a = 0; a < k; ++a)
+        if (f(mesh.element(subset_[i])[a])) return true;
+    return false;
+  };
+  std::vector<char> late_node(mesh.num_nodes(), 0), late(nblocks, 0);
+  for (Index n : late_nodes) late_node[n] = 1;
+  for (Index b = 0; b < nblocks; ++b) late[b] = for_nodes(b, [&](Index n) { return late_node[n] != 0; });
+  std::vector<int> min_late_color(mesh.num_nodes());
+  for (bool changed = true; changed;) {
+    std::fill(min_late_color.begin(), min_late_color.end(), coloring_.num_colors());
+    for (Index b = 0; b < nblocks; ++b)
+      if (late[b])
+        for_nodes(b, [&](Index n) {
+          min_late_color[n] = std::min(min_late_color[n], coloring_.color[b]);
+          return false;
+        });
+    changed = false;
+    for (Index b = 0; b < nblocks; ++b)
+      if (!late[b] && for_nodes(b, [&](Index n) { return min_late_color[n] < coloring_.color[b]; }))
+        late[b] = changed = true;
+  }
+  split_phases(late);
 }
 
-ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int,
-                                         std::span<double> stress6) const {
+ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int, std::span<double> stress6,
+                                         const std::function<void()>& between) const {
   const Mesh& mesh = model_.mesh;
   const Index* conn = mesh.conn.data();
   const int* mat = mesh.elem_material.data();
@@ -150,11 +191,15 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     block_worst_[b] = worst;
   };
 
-  for (int c = 0; c < coloring_.num_colors(); ++c) {
-    const auto items = coloring_.items_of(c);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) run_block(items[i]);
-    });
+  for (int p = 0; p < 2; ++p) {
+    if (p == 1 && between) between();
+    const std::vector<Index>& items = phase_items_[p];
+    const std::vector<Index>& offsets = phase_offsets_[p];
+    for (int c = 0; c < coloring_.num_colors(); ++c)
+      tbb::parallel_for(tbb::blocked_range<Index>(offsets[c], offsets[c + 1], 1),
+                        [&](const tbb::blocked_range<Index>& r) {
+                          for (Index i = r.begin(); i < r.end(); ++i) run_block(items[i]);
+                        });
   }
 
   ElementLoopResult res;

@@ -13,6 +13,8 @@
 // strain energy is summed per granule of kGranule consecutive elements, the
 // unit of ownership between ranks, so that sums over granules combined in
 // granule order do not depend on the decomposition.
+#include <array>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -47,7 +49,21 @@ class ElementForces {
   /// Compute only `elements` (ascending) from now on, and zero only `nodes`
   /// (ascending: the nodes of those elements) in f_int. Blocks without one
   /// of them are skipped. Without a call: every element and node.
-  void restrict_to(std::span<const Index> elements, std::span<const Index> nodes);
+  ///
+  /// `late_nodes` (any order): nodes whose positions arrive while compute()
+  /// runs (a halo exchange between its two phases, see compute). The blocks
+  /// are split into an early phase that reads none of them and a late phase,
+  /// such that no node gets a late contribution before an early one of a
+  /// higher color: the late set is the blocks touching a late node, closed
+  /// under "an early block whose color is above that of a late block sharing
+  /// a node turns late". Every node thus still receives its contributions in
+  /// color order, the same bits as in one phase.
+  void restrict_to(std::span<const Index> elements, std::span<const Index> nodes,
+                   std::span<const Index> late_nodes = {});
+
+  /// Blocks of the early phase and of the late phase (restrict_to).
+  Index early_blocks() const { return static_cast<Index>(phase_items_[0].size()); }
+  Index late_blocks() const { return static_cast<Index>(phase_items_[1].size()); }
 
   /// Strain energy of each granule's computed elements in the last compute(), J.
   std::span<const double> granule_energy() const { return granule_energy_; }
@@ -57,15 +73,22 @@ class ElementForces {
   /// stable_dt and min_jacobian are over the computed elements. When
   /// stress6 is not empty, also writes each element's Cauchy stress there
   /// (6 per element, as element_cauchy_stress6) for the fracture check.
-  ElementLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int, std::span<double> stress6 = {}) const;
+  /// `between` (if any) runs after the early blocks and before the late ones
+  /// (restrict_to): it must complete the late nodes' positions in x.
+  ElementLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int, std::span<double> stress6 = {},
+                            const std::function<void()>& between = {}) const;
 
   int num_colors() const { return coloring_.num_colors(); }
 
  private:
+  void split_phases(const std::vector<char>& late);
+
   const Model& model_;
   Coloring coloring_;
   std::vector<Index> subset_offsets_, subset_;  ///< CSR per block: its elements to compute
   std::vector<Index> zero_nodes_;               ///< nodes to zero after restrict_to (empty: all)
+  /// Per phase (early, late): the blocks in color order, CSR by color.
+  std::array<std::vector<Index>, 2> phase_items_, phase_offsets_;
   mutable std::vector<double> granule_energy_, block_dt_, block_min_J_;
   mutable std::vector<Index> block_worst_;
 };

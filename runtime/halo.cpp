@@ -14,6 +14,9 @@ static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are read as node-
 std::span<double> as_doubles(std::span<Vec3> v) {
   return {v.empty() ? nullptr : v.data()->data(), 3 * v.size()};
 }
+std::span<const double> as_doubles(std::span<const Vec3> v) {
+  return {v.empty() ? nullptr : v.data()->data(), 3 * v.size()};
+}
 }  // namespace
 
 Halo::Halo(const LocalMesh& local, MPI_Comm comm)
@@ -134,6 +137,14 @@ void Halo::end_update(std::span<double> values, int components) {
 void Halo::update_ghosts(std::span<double> values, int components, GhostCopies copies) {
   begin_update(values, components, copies);
   end_update(values, components);
+}
+
+void Halo::begin_update(std::span<const Vec3> values, GhostCopies copies) {
+  begin_update(as_doubles(values), 3, copies);
+}
+
+void Halo::end_update(std::span<Vec3> values) {
+  end_update(as_doubles(values), 3);
 }
 
 void Halo::update_ghosts(std::span<Vec3> values, GhostCopies copies) {

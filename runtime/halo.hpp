@@ -73,8 +73,10 @@ class Halo {
   /// Post the sends of owned values to the ranks holding those `copies`, and the receives.
   void begin_update(std::span<const double> values, int components,
                     GhostCopies copies = GhostCopies::all);
+  void begin_update(std::span<const Vec3> values, GhostCopies copies = GhostCopies::all);
   /// Wait, then overwrite the copies chosen in begin_update with their owners' values.
   void end_update(std::span<double> values, int components);
+  void end_update(std::span<Vec3> values);
   /// begin_update + end_update.
   void update_ghosts(std::span<double> values, int components,
                      GhostCopies copies = GhostCopies::all);

@@ -137,12 +137,15 @@ double Simulation::next_dt() const {
   return remaining < 1.5 * dt && remaining > dt ? 0.5 * remaining : std::min(dt, remaining);
 }
 
-void Simulation::compute_forces(long step, double time) {
+void Simulation::compute_forces(long step, double time, const std::function<void()>& between) {
   if (cohesive_nodes_) {
     const std::span<Vec3> arrays[] = {x_};
     timed(comm_seconds_, [&] { dec_->share(*cohesive_nodes_, arrays); });
   }
-  timed(element_seconds_, [&] { last_elements_ = elements_.compute(x_, f_int_, stress6_); });
+  // `between` (the end of the ghost update) is timed as communication.
+  const double comm_before = comm_seconds_;
+  timed(element_seconds_, [&] { last_elements_ = elements_.compute(x_, f_int_, stress6_, between); });
+  element_seconds_ -= comm_seconds_ - comm_before;
   if (fracture_) {
     const CohesiveEnergy ce = fracture_->add_forces(x_, f_int_);
     ledger_.cohesive_stored = ce.stored;
@@ -235,7 +238,9 @@ void Simulation::step() {
       ++ledger_.contact_capped_steps;
     }
   }
-  timed(comm_seconds_, [&] { dec_->update_ghost_only(x_); });
+  // The ghost-only positions travel while the elements that do not read them
+  // are computed (ElementForces::restrict_to).
+  timed(comm_seconds_, [&] { dec_->begin_ghost_update(x_); });
   // Gravity's work over the step's displacement (the projection's included),
   // per home granule.
   for (Index gr : dec_->owned_granules()) {
@@ -247,7 +252,7 @@ void Simulation::step() {
     granule_sums_[gr * kGranuleSums + 9] = 0;
   }
 
-  compute_forces(step_ + 1, time_ + dt);
+  compute_forces(step_ + 1, time_ + dt, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
 
   dec_->for_touched(n, half_kick);
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
@@ -294,7 +299,7 @@ void Simulation::apply_fracture() {
 
 void Simulation::share_plans() {
   if (!dec_->distributed()) return;
-  elements_.restrict_to(dec_->local_elements(), dec_->held_nodes());
+  elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
   auto plan = [&](std::vector<Index> nodes) { return std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(nodes))); };
   if (contact_) surface_nodes_ = plan(contact_->surface().vertices);
   if (fracture_ && fracture_->cohesive_count() > 0) cohesive_nodes_ = plan(fracture_->cohesive_nodes());

@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -107,8 +108,9 @@ class Simulation {
 
  private:
   /// Forces and accelerations at x_; `step` and `time` (of the configuration
-  /// x_) name it when an element is inverted.
-  void compute_forces(long step, double time);
+  /// x_) name it when an element is inverted. `between` goes to
+  /// ElementForces::compute: it completes the ghost-only positions.
+  void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
   void write_outputs(bool fields);
   void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 2> contact_pairs_range);

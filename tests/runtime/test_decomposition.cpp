@@ -82,7 +82,8 @@ TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
   // Only touched nodes hold the right value; the rest is garbage.
   std::vector<Vec3> x(nn, Vec3::Constant(-7.0));
   for (Index n : d.touched_nodes()) x[n] = tag(n);
-  d.update_ghost_only(x);
+  d.begin_ghost_update(x);
+  d.end_ghost_update(x);
   for (Index n : d.held_nodes()) EXPECT_TRUE(same_bits(x[n], tag(n))) << "node " << n;
   // Share every third node with every rank; gather all to rank 0.
   std::vector<Index> subset;
@@ -114,8 +115,19 @@ TEST(Decomposition, GranuleSumsAreExactAndRestrictedForcesAreSerial) {
   ElementForces serial(m), restricted(m);
   std::vector<Vec3> f_serial(nn), f(nn, Vec3::Constant(1e300));
   const ElementLoopResult whole = serial.compute(x, f_serial);
-  if (d.distributed()) restricted.restrict_to(d.local_elements(), d.held_nodes());
-  restricted.compute(x, f);
+  if (d.distributed()) restricted.restrict_to(d.local_elements(), d.held_nodes(), d.ghost_only_nodes());
+  const Index blocks = (m.mesh.num_elements() + ElementForces::kBlock - 1) / ElementForces::kBlock;
+  EXPECT_EQ(restricted.early_blocks() + restricted.late_blocks(), blocks);
+  // The ghost-only positions arrive between the two phases: until then they
+  // are NaN, so an early block reading one would spoil the forces it scatters.
+  std::vector<Vec3> x_late = x;
+  for (Index n : d.ghost_only_nodes()) x_late[n] = Vec3::Constant(std::nan(""));
+  bool between_ran = false;
+  restricted.compute(x_late, f, {}, [&] {
+    for (Index n : d.ghost_only_nodes()) x_late[n] = x[n];
+    between_ran = true;
+  });
+  EXPECT_TRUE(between_ran);
   for (Index n : d.touched_nodes()) EXPECT_TRUE(same_bits(f[n], f_serial[n])) << "node " << n;
 
   // Owned granules' energies, combined, summed in granule order: the serial total.
