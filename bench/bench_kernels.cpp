@@ -46,7 +46,7 @@
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
 #include "mesh/reorder.hpp"
-#include "runtime/coloring.hpp"
+#include "mesh/coloring.hpp"
 
 using namespace shatter;
 

@@ -174,7 +174,7 @@ inline double dcr_bisect(const DcrCubic& p, double a, double b) {
 struct DcrPenetration {
   bool penetrating = false;
   double time = 0.0;         ///< t* in [0, 1]: start of the final stretch with g < 0
-  double orientation = 1.0;  ///< s of g = s V
+  double orientation = 1.0;  ///< s of g = s V (set when penetrating)
 };
 
 /// Whether the pair penetrated during the step, positions moving linearly from X_old
@@ -189,6 +189,15 @@ struct DcrPenetration {
 /// tol = dcr_touch_tolerance(kind, X_old, X_new).
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
   DcrPenetration out;
+  // Exact exits before the tolerance (two square roots), for most candidates: s V(X_new) < -tol
+  // needs V(X_new) > 0 for a vertex and a face (s = -1); for two edges whose volume keeps its
+  // sign (s = its sign unless |V(X_old)| <= tol) it needs |V(X_old)| <= tol < |V(X_new)|.
+  const double V_new = pair_volume(X_new);
+  if (kind == DcrPairKind::VertexFace && !(V_new > 0.0)) return out;
+  if (kind == DcrPairKind::EdgeEdge) {
+    const double V_old = pair_volume(X_old);
+    if (V_old * V_new > 0.0 && std::abs(V_new) <= std::abs(V_old)) return out;
+  }
   out.orientation = dcr_orientation(kind, X_old, X_new);
   const double s = out.orientation;
   const double tol = dcr_touch_tolerance(kind, X_old, X_new);

@@ -8,7 +8,6 @@
 
 #include "contact/candidates.hpp"
 #include "kernels/error.hpp"
-#include "runtime/coloring.hpp"
 #include "runtime/contact_partition.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/parallel.hpp"
@@ -134,30 +133,19 @@ void ContactStage::assign_pairs(std::span<const Vec3> x) {
   for (size_t k = 0; k < pairs_.size(); ++k) pair_rank_[k] = primitive_rank_[primitive[k]];
 }
 
-void ContactStage::gather_active(std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
-  const int rank = dec_->rank();
-  const std::vector<Index> kept = parallel_select(static_cast<Index>(pairs_.size()), [&](Index i) {
-    return pair_rank_[i] == rank && pair_boxes_overlap(pairs_[i], x_old, x_new);
-  });
-  // Each rank's list is ascending: sorted, the concatenation is the canonical order.
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Index> all = dec_->allgather(kept);
-  profile_.exchange_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::sort(all.begin(), all.end());
-  profile_.exchange_bytes += static_cast<long>(sizeof(Index) * kept.size() * (dec_->size() - 1));
-  active_.resize(all.size());
-  active_rank_.resize(all.size());
-  for (size_t k = 0; k < all.size(); ++k) {
-    active_[k] = pairs_[all[k]];
-    active_rank_[k] = pair_rank_[all[k]];
+std::array<long, 3> ContactStage::owned_pairs_range() const {
+  long v[2] = {-profile_.owned_pairs, profile_.owned_pairs}, sum = profile_.owned_pairs;
+  if (dec_) {
+    MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_LONG, MPI_MAX, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_LONG, MPI_SUM, dec_->comm());
   }
-  profile_.owned_pairs += static_cast<long>(kept.size());
+  return {-v[0], v[1], sum};
 }
 
-std::array<long, 2> ContactStage::owned_pairs_range() const {
-  long v[2] = {-profile_.owned_pairs, profile_.owned_pairs};
-  if (dec_) MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_LONG, MPI_MAX, dec_->comm());
-  return {-v[0], v[1]};
+ContactPairs ContactStage::active_pairs() const {
+  ContactPairs out(mine_.size());
+  for (size_t k = 0; k < mine_.size(); ++k) out[k] = pairs_[mine_[k]];
+  return out;
 }
 
 DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
@@ -170,82 +158,31 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
     last = now;
     exchanged = profile_.exchange_seconds;
   };
-  auto timed_exchange = [this](auto f) {
-    const auto t0 = clock::now();
-    f();
-    profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
-  };
   const bool valid = candidates_valid(x_old, x_new);
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new);
   lap(profile_.search_seconds);
-  if (dec_) {
-    gather_active(x_old, x_new);
-  } else {
-    const std::vector<Index> kept = parallel_select(static_cast<Index>(pairs_.size()), [&](Index i) {
-      return pair_boxes_overlap(pairs_[i], x_old, x_new);
-    });
-    active_.resize(kept.size());
-    for (size_t k = 0; k < kept.size(); ++k) active_[k] = pairs_[kept[k]];
-  }
+  const int rank = dec_ ? dec_->rank() : 0;
+  mine_ = parallel_select(static_cast<Index>(pairs_.size()), [&](Index i) {
+    return (!dec_ || pair_rank_[i] == rank) && pair_boxes_overlap(pairs_[i], x_old, x_new);
+  });
   lap(profile_.filter_seconds);
-  node_slot_.resize(x_new.size(), -1);
-  const Index slots = contact_pair_nodes(active_, pair_offsets_, pair_slots_, node_slot_);
-  const Coloring colors = greedy_coloring(pair_offsets_, pair_slots_, slots);
-  lap(profile_.coloring_seconds);
-  const DcrPairColors dcr_colors{colors.offsets, colors.items, pair_slots_, slots};
-  DcrResult r;
-  if (!dec_) {
-    r = resolve_contacts(active_, x_new, x_old, v, inv_mass, dt, options_, dcr_colors);
-  } else {
-    // A moved pair travels as its index, its dissipation and its four nodes' x_new and v.
-    constexpr int kRecord = 26;
-    const int ranks = dec_->size();
-    std::vector<int> counts(ranks), displs(ranks, 0);
-    DcrRemote remote{active_rank_, dec_->rank(), [&](const DcrRemote::Moves& here, DcrRemote::Moves& there) {
-                       send_.clear();
-                       for (size_t k = 0; k < here.pairs.size(); ++k) {
-                         const Index i = here.pairs[k];
-                         send_.push_back(i);
-                         send_.push_back(here.dissipated[k]);
-                         for (const Index n : active_[i].nodes)
-                           for (int c = 0; c < 3; ++c) send_.push_back(x_new[n][c]);
-                         for (const Index n : active_[i].nodes)
-                           for (int c = 0; c < 3; ++c) send_.push_back(v[n][c]);
-                       }
-                       const int mine = static_cast<int>(send_.size());
-                       timed_exchange([&] {
-                         MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, dec_->comm());
-                         for (int q = 1; q < ranks; ++q) displs[q] = displs[q - 1] + counts[q - 1];
-                         receive_.resize(displs[ranks - 1] + counts[ranks - 1]);
-                         MPI_Allgatherv(send_.data(), mine, MPI_DOUBLE, receive_.data(), counts.data(),
-                                        displs.data(), MPI_DOUBLE, dec_->comm());
-                       });
-                       profile_.exchange_bytes += static_cast<long>(sizeof(double)) * mine * (ranks - 1);
-                       for (int q = 0; q < ranks; ++q) {
-                         if (q == dec_->rank()) continue;
-                         for (int at = displs[q]; at < displs[q] + counts[q]; at += kRecord) {
-                           const double* rec = receive_.data() + at;
-                           const auto i = static_cast<Index>(rec[0]);
-                           there.pairs.push_back(i);
-                           there.dissipated.push_back(rec[1]);
-                           for (int k = 0; k < 4; ++k) {
-                             const Index n = active_[i].nodes[k];
-                             x_new[n] = Vec3(rec[2 + 3 * k], rec[3 + 3 * k], rec[4 + 3 * k]);
-                             v[n] = Vec3(rec[14 + 3 * k], rec[15 + 3 * k], rec[16 + 3 * k]);
-                           }
-                         }
-                       }
-                     }};
-    r = resolve_contacts(active_, x_new, x_old, v, inv_mass, dt, options_, dcr_colors, &remote);
-  }
+  DcrGather gather;
+  if (dec_)
+    gather = [&](std::vector<Index>& found) {
+      const auto t0 = clock::now();
+      profile_.exchange_bytes += static_cast<long>(sizeof(Index) * found.size() * (dec_->size() - 1));
+      found = dec_->allgather(found);
+      std::sort(found.begin(), found.end());
+      profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+    };
+  const DcrResult r = resolve_contacts(pairs_, mine_, x_new, x_old, v, inv_mass, dt, options_, scratch_, gather);
   lap(profile_.sweep_seconds);
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());
-  profile_.active_pairs += static_cast<long>(active_.size());
-  profile_.colors += colors.num_colors();
+  profile_.owned_pairs += static_cast<long>(mine_.size());
+  profile_.detections += r.detected;
   profile_.sweeps += r.sweeps;
-  profile_.exchanges += r.exchanges;
   return r;
 }
 

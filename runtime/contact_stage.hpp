@@ -18,10 +18,10 @@
 // holds the surface state (the caller shares it) and runs the search; the
 // surface primitives are partitioned by RCB (ContactPartition) and a pair
 // belongs to the rank of its face (vertex-face) or first edge (edge-edge).
-// Each rank filters its own candidates, the step's pairs are gathered in the
-// canonical order and colored on every rank, and each rank resolves its own
-// pairs of a color before the moved nodes' states are exchanged for the next
-// one (DcrRemote): every rank ends with the serial bits of every surface node.
+// Each rank filters and detects its own candidates; the few pairs found
+// penetrating are gathered, and every rank resolves all of them in the same
+// order (resolve_contacts): every rank ends with the serial bits of every
+// surface node, and only pair indices travel.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -39,19 +39,17 @@ namespace shatter {
 struct ContactProfile {
   double verlet_seconds = 0;    ///< checking that the candidates of the last search still serve
   double search_seconds = 0;    ///< the searches themselves
-  double filter_seconds = 0;    ///< the step's box test over the candidates
-  double coloring_seconds = 0;  ///< node slots and the coloring of the step's pairs
-  double sweep_seconds = 0;     ///< the DCR sweeps
+  double filter_seconds = 0;    ///< the step's box test over this rank's candidates
+  double sweep_seconds = 0;     ///< DCR: detection, coloring and resolution rounds
   long steps = 0, searches = 0;
-  long candidates = 0;    ///< candidates of the search in force, summed over steps
-  long active_pairs = 0;  ///< pairs DCR checked, summed over steps
-  long colors = 0, sweeps = 0;
+  long candidates = 0;   ///< candidates of the search in force, summed over steps
+  long owned_pairs = 0;  ///< this rank's candidates that passed the box test, summed over steps
+  long detections = 0;   ///< pair detections run here, summed over steps
+  long sweeps = 0;       ///< detection rounds, summed over steps
   // On several ranks:
-  long owned_pairs = 0;      ///< pairs resolved here, summed over steps
-  long exchange_bytes = 0;   ///< bytes this rank sent for the step's pairs and DCR moves
-  double exchange_seconds = 0;  ///< in those exchanges (not in the times above)
-  long repartitions = 0;     ///< RCB partitions computed
-  long exchanges = 0;        ///< DCR exchanges (DcrRemote)
+  long exchange_bytes = 0;      ///< bytes this rank sent: the pairs it found penetrating
+  double exchange_seconds = 0;  ///< in those gathers (not in the times above)
+  long repartitions = 0;        ///< RCB partitions computed
 };
 
 class Decomposition;
@@ -74,16 +72,20 @@ class ContactStage {
   void rebuild(const Mesh& mesh);
 
   const ContactSurface& surface() const { return surface_; }
-  /// The pairs DCR checked in the last apply() (equal to a fresh search's).
-  const ContactPairs& active_pairs() const { return active_; }
+  /// The candidates of the search in force (the same on every rank; DcrResult::unresolved
+  /// indexes them).
+  const ContactPairs& candidates() const { return pairs_; }
+  /// This rank's pairs that DCR checked in the last apply(): on one rank, equal to the
+  /// pairs of a fresh search whose swept boxes overlap.
+  ContactPairs active_pairs() const;
   /// Seconds spent in the search (the reuse check and the step's filter
-  /// included) and in DCR (coloring and sweeps) so far; number of searches run.
+  /// included) and in DCR (detection, coloring, resolution) so far; number of searches run.
   double search_seconds() const { return profile_.verlet_seconds + profile_.search_seconds + profile_.filter_seconds; }
-  double dcr_seconds() const { return profile_.coloring_seconds + profile_.sweep_seconds; }
+  double dcr_seconds() const { return profile_.sweep_seconds; }
   long searches() const { return profile_.searches; }
   const ContactProfile& profile() const { return profile_; }
-  /// Smallest and largest profile().owned_pairs over the ranks (collective).
-  std::array<long, 2> owned_pairs_range() const;
+  /// Smallest, largest and sum of profile().owned_pairs over the ranks (collective).
+  std::array<long, 3> owned_pairs_range() const;
   /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
   /// median surface edge length.
   double margin() const { return margin_; }
@@ -93,19 +95,16 @@ class ContactStage {
   void search(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
   /// Ranks of the new candidates; a new RCB partition when needed (the rule in contact_stage.cpp).
   void assign_pairs(std::span<const Vec3> x);
-  /// The step's pairs: this rank's candidates that pass the box test, gathered from every rank.
-  void gather_active(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
 
   ContactSurface surface_;
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
   bool have_candidates_ = false;
-  ContactPairs pairs_;   ///< candidates of the last search (inflated boxes)
-  ContactPairs active_;  ///< this step's pairs: pairs_ whose swept boxes overlap
+  ContactPairs pairs_;          ///< candidates of the last search (inflated boxes)
+  std::vector<Index> mine_;     ///< this step's pairs: this rank's pairs_ whose swept boxes overlap
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
-  std::vector<Index> pair_offsets_, pair_slots_;
-  std::vector<Index> node_slot_;  ///< contact_pair_nodes' scratch, -1 per mesh node
+  DcrScratch scratch_;
   ContactProfile profile_;
   // Several ranks:
   const Decomposition* dec_ = nullptr;  ///< null on one rank
@@ -114,8 +113,6 @@ class ContactStage {
   std::vector<int> primitive_rank_;    ///< rank of each triangle, then of each edge
   bool repartition_ = true;            ///< the surface changed: partition at the next search
   std::vector<int> pair_rank_;         ///< rank of each candidate of pairs_
-  std::vector<int> active_rank_;       ///< rank of each active pair
-  std::vector<double> send_, receive_;
 };
 
 }  // namespace shatter

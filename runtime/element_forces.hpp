@@ -18,7 +18,7 @@
 #include <span>
 #include <vector>
 
-#include "runtime/coloring.hpp"
+#include "mesh/coloring.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {

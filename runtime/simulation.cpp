@@ -48,8 +48,8 @@ struct BodyRow {
 std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const ContactPairs& pairs,
                                 const DcrResult& r, long step, double time) {
   std::ostringstream os;
-  os << "step " << step << ", t = " << time << " s: DCR sweeps reached the cap (contact.max_sweeps = " << r.sweeps
-     << ") with penetrations left (contact.on_sweep_cap: fail)";
+  os << "step " << step << ", t = " << time << " s: DCR sweeps reached the cap (contact.max_sweeps = "
+     << model.scene.contact->max_sweeps << ") with penetrations left (contact.on_sweep_cap: fail)";
   if (r.unresolved >= 0 && static_cast<size_t>(r.unresolved) < pairs.size()) {
     const ContactPair& p = pairs[r.unresolved];
     Vec3 centre = Vec3::Zero();
@@ -231,10 +231,10 @@ void Simulation::step() {
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
       if (model_.scene.contact->sweep_cap_fatal)
-        throw Error(sweep_cap_diagnosis(model_, x_, contact_->active_pairs(), r, step_ + 1, time_ + dt));
+        throw Error(sweep_cap_diagnosis(model_, x_, contact_->candidates(), r, step_ + 1, time_ + dt));
       if (ledger_.contact_capped_steps == 0 && !opt_.quiet && dec_->rank() == 0)
         std::fprintf(stderr, "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
-                     "counted in history.csv column contact_capped_steps\n", step_ + 1, r.sweeps);
+                     "counted in history.csv column contact_capped_steps\n", step_ + 1, model_.scene.contact->max_sweeps);
       ++ledger_.contact_capped_steps;
     }
   }
@@ -646,7 +646,7 @@ long Simulation::run() {
   if (!opt_.out_dir.empty()) {
     if (fracture_) write_fragments();
     const DecompositionStats stats = dec_->stats();
-    const std::array<long, 2> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 2>{};
+    const std::array<long, 3> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 3>{};
     if (root) write_summary(wall, stats, pairs);
   }
   return step_;
@@ -667,7 +667,7 @@ void Simulation::write_fragments() {
   }
 }
 
-void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 2> owned_pairs) {
+void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -731,11 +731,10 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
     const double steps = std::max(1L, cp.steps);
     j.add("contact_verlet_time", cp.verlet_seconds);
     j.add("contact_filter_time", cp.filter_seconds);
-    j.add("contact_coloring_time", cp.coloring_seconds);
     j.add("contact_sweep_time", cp.sweep_seconds);
     j.add("contact_candidates_per_step", cp.candidates / steps);
-    j.add("contact_pairs_per_step", cp.active_pairs / steps);
-    j.add("contact_colors_per_step", cp.colors / steps);
+    j.add("contact_pairs_per_step", owned_pairs[2] / steps);
+    j.add("contact_detections_per_step", cp.detections / steps);
     j.add("contact_sweeps_per_step", cp.sweeps / steps);
     if (dec_->distributed()) {
       j.add("contact_pairs_per_step_rank_min", owned_pairs[0] / steps);
@@ -743,7 +742,6 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
       j.add("contact_exchange_time", cp.exchange_seconds);
       j.add("contact_exchange_bytes_per_step", cp.exchange_bytes / steps);
       j.add("contact_repartitions", cp.repartitions);
-      j.add("contact_exchanges_per_step", cp.exchanges / steps);
     }
   }
   j.write(opt_.out_dir / "summary.json");

@@ -113,7 +113,7 @@ class Simulation {
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
   void write_outputs(bool fields);
-  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 2> contact_pairs_range);
+  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range);
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.

@@ -1,7 +1,7 @@
 // DCR sweeps (contact/dcr.hpp) on small stacks of sheets: every penetration is
 // removed (checked by an independent height-field test, not by the DCR kernels),
 // fixed nodes stay, momentum and energy are accounted for, and the result is
-// bitwise identical for 1, 2 and 4 threads.
+// bitwise identical for 1, 2 and 4 threads and when ranks divide the detection.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
@@ -15,7 +15,6 @@
 #include "contact/dcr.hpp"
 #include "kernels/error.hpp"
 #include "expect_close.hpp"
-#include "runtime/coloring.hpp"
 
 using namespace shatter;
 
@@ -195,24 +194,18 @@ int count_penetrations(const Stack& s, const std::vector<Vec3>& x) {
   return bad;
 }
 
-/// A coloring of the pairs with their compact node slots.
-struct PairColoring : Coloring {
-  std::vector<Index> slots;
-  Index num_slots = 0;
-  DcrPairColors dcr() const { return {offsets, items, slots, num_slots}; }
-};
-
-PairColoring color_pairs(const Stack& s) {
-  std::vector<Index> offsets, node_slot(s.x_old.size(), -1);
-  PairColoring c;
-  c.num_slots = contact_pair_nodes(s.pairs, offsets, c.slots, node_slot);
-  static_cast<Coloring&>(c) = greedy_coloring(offsets, c.slots, c.num_slots);
-  return c;
+std::vector<Index> every_pair(const Stack& s) {
+  std::vector<Index> all(s.pairs.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Index>(i);
+  return all;
 }
 
-DcrResult run(Stack& s, const DcrOptions& options, const PairColoring& c) {
-  return resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, c.dcr());
+DcrResult run(Stack& s, const DcrOptions& options, std::span<const Index> mine, const DcrGather& gather = {}) {
+  DcrScratch scratch;
+  return resolve_contacts(s.pairs, mine, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, scratch, gather);
 }
+
+DcrResult run(Stack& s, const DcrOptions& options) { return run(s, options, every_pair(s)); }
 
 struct Totals {
   Vec3 p = Vec3::Zero(), L = Vec3::Zero();
@@ -241,8 +234,7 @@ TEST_P(DcrStack, OnFixedGroundIsResolved) {
   Stack s = make_stack(5, 5, true, 1, GetParam());
   ASSERT_GT(count_penetrations(s, s.x_new), 0);
   const std::vector<Vec3> x0 = s.x_new, v0 = s.v;
-  const PairColoring c = color_pairs(s);
-  const DcrResult r = run(s, {0.5, 0.3, 1e-6, 200}, c);
+  const DcrResult r = run(s, {0.5, 0.3, 1e-6, 200});
   EXPECT_FALSE(r.capped);
   EXPECT_GT(r.contacts, 0);
   EXPECT_GE(r.sweeps, 2);
@@ -254,7 +246,6 @@ TEST_P(DcrStack, OnFixedGroundIsResolved) {
       EXPECT_EQ(s.v[i], v0[i]);
     }
   RecordProperty("pairs", static_cast<int>(s.pairs.size()));
-  RecordProperty("colors", c.num_colors());
   RecordProperty("contacts", r.contacts);
   RecordProperty("sweeps", r.sweeps);
 }
@@ -262,22 +253,47 @@ TEST_P(DcrStack, OnFixedGroundIsResolved) {
 INSTANTIATE_TEST_SUITE_P(DcrSweep, DcrStack, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "ThinSheets" : "ThickBodies"; });
 
-TEST(DcrSweep, OnePairPerColorAlsoResolves) {
-  Stack s = make_stack(4, 4, true, 2, true);
-  PairColoring c = color_pairs(s);
-  c.offsets.clear();
-  c.items.clear();
-  for (Index i = 0; i <= static_cast<Index>(s.pairs.size()); ++i) c.offsets.push_back(i);
-  for (Index i = 0; i < static_cast<Index>(s.pairs.size()); ++i) c.items.push_back(i);
-  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200}, c);
-  EXPECT_FALSE(r.capped);
-  EXPECT_EQ(count_penetrations(s, s.x_new), 0);
+// Ranks divide the detection: a rank detects its own pairs and the gather hands every rank
+// the pairs found anywhere. Here a second "rank" owns the odd pairs and its detection runs
+// inside the gather (on the same state, as the other rank's would): the result must be the
+// one-rank result bit for bit.
+TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
+  const Stack initial = make_stack(5, 5, true, 2, true);
+  Stack one = initial, split = initial;
+  const DcrOptions options{0.5, 0.3, 1e-6, 200};
+  const DcrResult r1 = run(one, options);
+  std::vector<Index> even, odd;
+  for (Index i = 0; i < static_cast<Index>(split.pairs.size()); ++i) (i % 2 ? odd : even).push_back(i);
+  int gathers = 0;
+  const DcrResult r2 = run(split, options, even, [&](std::vector<Index>& found) {
+    ++gathers;
+    for (const Index i : odd) {
+      const ContactPair& p = split.pairs[i];
+      PairPoints X_old, X_new;
+      for (int k = 0; k < 4; ++k) {
+        X_old.col(k) = split.x_old[p.nodes[k]];
+        X_new.col(k) = split.x_new[p.nodes[k]];
+      }
+      const auto kind = p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
+      if (dcr_detect(kind, X_old, X_new).penetrating) found.push_back(i);
+    }
+    std::sort(found.begin(), found.end());
+  });
+  EXPECT_GT(r1.contacts, 0);
+  EXPECT_EQ(gathers, r2.sweeps);
+  EXPECT_EQ(r2.sweeps, r1.sweeps);
+  EXPECT_EQ(r2.contacts, r1.contacts);
+  EXPECT_LT(r2.detected, r1.detected);
+  EXPECT_EQ(std::memcmp(&r2.dissipated, &r1.dissipated, sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(split.x_new.data(), one.x_new.data(), one.x_new.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(std::memcmp(split.v.data(), one.v.data(), one.v.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(count_penetrations(split, split.x_new), 0);
 }
 
 TEST(DcrSweep, ElasticFrictionlessStackConservesMomentumAndEnergy) {
   Stack s = make_stack(5, 4, false, 3, true);
   const Totals before = totals(s, s.x_new, s.v);
-  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200}, color_pairs(s));
+  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 200});
   const Totals after = totals(s, s.x_new, s.v);
   EXPECT_FALSE(r.capped);
   EXPECT_GT(r.contacts, 0);
@@ -291,7 +307,7 @@ TEST(DcrSweep, ElasticFrictionlessStackConservesMomentumAndEnergy) {
 TEST(DcrSweep, DissipationMatchesTheKineticEnergyLost) {
   Stack s = make_stack(5, 4, false, 4, true);
   const Totals before = totals(s, s.x_new, s.v);
-  const DcrResult r = run(s, {0.3, 0.4, 1e-6, 200}, color_pairs(s));
+  const DcrResult r = run(s, {0.3, 0.4, 1e-6, 200});
   const Totals after = totals(s, s.x_new, s.v);
   EXPECT_FALSE(r.capped);
   EXPECT_GT(r.dissipated, 0);
@@ -321,9 +337,7 @@ TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
     s.pairs.push_back({ContactPair::VertexFace, {first, first + 1, first + 2, first + 3}});
   }
   const std::vector<Vec3> v0 = s.v;
-  const PairColoring c = color_pairs(s);
-  EXPECT_EQ(c.num_colors(), 1);
-  const DcrResult r = run(s, {1.0, 0.5, 1e-6, 10}, c);
+  const DcrResult r = run(s, {1.0, 0.5, 1e-6, 10});
   EXPECT_EQ(r.contacts, 50);
   EXPECT_EQ(r.sweeps, 2);
   const Totals before = totals(s, s.x_new, v0), after = totals(s, s.x_new, s.v);
@@ -335,21 +349,21 @@ TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
 
 TEST(DcrSweep, CapIsReported) {
   Stack s = make_stack(4, 4, true, 6);
-  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 1}, color_pairs(s));
+  const DcrResult r = run(s, {1.0, 0.0, 1e-6, 1});
   EXPECT_EQ(r.sweeps, 1);
   EXPECT_TRUE(r.capped);
+  EXPECT_GE(r.unresolved, 0);
 }
 
 TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
   const Stack initial = make_stack(5, 6, true, 7, true);
-  const PairColoring c = color_pairs(initial);
   const tbb::global_control allow(tbb::global_control::max_allowed_parallelism, 4);  // even on fewer cores
   std::vector<Stack> runs;
   std::vector<DcrResult> results;
   for (const int threads : {1, 2, 4}) {
     Stack s = initial;
     tbb::task_arena arena(threads);
-    results.push_back(arena.execute([&] { return run(s, {0.4, 0.3, 1e-6, 200}, c); }));
+    results.push_back(arena.execute([&] { return run(s, {0.4, 0.3, 1e-6, 1000}); }));
     runs.push_back(std::move(s));
   }
   for (size_t k = 1; k < runs.size(); ++k) {
@@ -364,9 +378,10 @@ TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
 
 TEST(DcrSweep, RejectsInconsistentInput) {
   Stack s = make_stack(2, 2, true, 8);
-  const PairColoring c = color_pairs(s);
+  const std::vector<Index> all = every_pair(s);
+  DcrScratch scratch;
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, c.dcr()), Error);
-  const std::vector<Index> no_items;
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {c.offsets, no_items, c.slots, c.num_slots}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, all, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, scratch), Error);
+  const std::vector<Index> beyond{static_cast<Index>(s.pairs.size())};
+  EXPECT_THROW(resolve_contacts(s.pairs, beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, scratch), Error);
 }

@@ -1,4 +1,4 @@
-#include "runtime/coloring.hpp"
+#include "mesh/coloring.hpp"
 
 #include <bit>
 #include <cstdint>
