@@ -12,18 +12,30 @@
 namespace shatter {
 namespace {
 
-template <size_t K>
-Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old,
-              std::span<const Vec3> x_new) {
-  Box b{x_old[nodes[0]], x_old[nodes[0]]};
-  for (const Index n : nodes) {
-    b.lo = b.lo.cwiseMin(x_old[n]).cwiseMin(x_new[n]);
-    b.hi = b.hi.cwiseMax(x_old[n]).cwiseMax(x_new[n]);
+/// The inflated box of K points moving from x_old(k) to x_new(k), k < K.
+template <size_t K, class Old, class New>
+Box swept_box(Old x_old, New x_new) {
+  Box b{x_old(0), x_old(0)};
+  for (size_t k = 0; k < K; ++k) {
+    b.lo = b.lo.cwiseMin(x_old(k)).cwiseMin(x_new(k));
+    b.hi = b.hi.cwiseMax(x_old(k)).cwiseMax(x_new(k));
   }
   const double grow = kBoxInflation * (b.hi - b.lo).maxCoeff();
   b.lo.array() -= grow;
   b.hi.array() += grow;
   return b;
+}
+
+template <size_t K>
+Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
+  return swept_box<K>([&](size_t k) { return x_old[nodes[k]]; }, [&](size_t k) { return x_new[nodes[k]]; });
+}
+
+/// The swept box of the K columns of a pair's points from column `first` on.
+template <size_t K>
+Box swept_box(const PairPoints& X_old, const PairPoints& X_new, int first) {
+  return swept_box<K>([&](size_t k) { return Vec3(X_old.col(first + k)); },
+                      [&](size_t k) { return Vec3(X_new.col(first + k)); });
 }
 
 template <size_t K, class Nodes>
@@ -86,13 +98,19 @@ std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e
   return ContactPair{ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}};
 }
 
+bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new) {
+  if (kind == ContactPair::VertexFace)
+    return boxes_overlap(swept_box<1>(X_old, X_new, 0), swept_box<3>(X_old, X_new, 1));
+  return boxes_overlap(swept_box<2>(X_old, X_new, 0), swept_box<2>(X_old, X_new, 2));
+}
+
 bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
-  const auto& n = pair.nodes;
-  if (pair.kind == ContactPair::VertexFace)
-    return boxes_overlap(swept_box(std::array<Index, 1>{n[0]}, x_old, x_new),
-                         swept_box(std::array<Index, 3>{n[1], n[2], n[3]}, x_old, x_new));
-  return boxes_overlap(swept_box(std::array<Index, 2>{n[0], n[1]}, x_old, x_new),
-                       swept_box(std::array<Index, 2>{n[2], n[3]}, x_old, x_new));
+  PairPoints X_old, X_new;
+  for (int k = 0; k < 4; ++k) {
+    X_old.col(k) = x_old[pair.nodes[k]];
+    X_new.col(k) = x_new[pair.nodes[k]];
+  }
+  return pair_boxes_overlap(pair.kind, X_old, X_new);
 }
 
 void canonicalize(ContactPairs& pairs) {

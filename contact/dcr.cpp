@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "contact/candidates.hpp"
 #include "kernels/error.hpp"
 #include "mesh/coloring.hpp"
 
@@ -73,32 +74,41 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
   std::vector<Index> resolved;  // every pair resolved, with repeats
   std::vector<double> dissipated;
   std::vector<std::uint8_t> active;
+  // The first round's box test keeps the pairs of mine that may touch; later rounds check
+  // only those, and only when a node moved in the previous round.
+  std::vector<Index>& kept = scratch.overlapping;
   bool first_round = true;
   while (true) {
-    // Detection: the rank's pairs that may penetrate (read only, in parallel).
-    // hit: 0 not checked, 1 checked and clean, 2 penetrating.
+    // Detection (read only, in parallel). hit: 0 not checked, 1 checked and clean,
+    // 2 penetrating, and in the first round 3 for a pair whose swept boxes do not overlap.
     const long previous = scratch.stamp;
     const long stamp = ++scratch.stamp;
-    std::vector<std::uint8_t> hit(mine.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, mine.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    const std::span<const Index> check = first_round ? mine : std::span<const Index>(kept);
+    std::vector<std::uint8_t> hit(check.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, check.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t k = r.begin(); k != r.end(); ++k) {
-        const ContactPair& p = pairs[mine[k]];
+        const ContactPair& p = pairs[check[k]];
         if (!first_round &&
             std::none_of(p.nodes.begin(), p.nodes.end(), [&](Index n) { return scratch.moved[n] == previous; }))
           continue;
-        if (!distinct_nodes(p)) continue;
         PairPoints X_old, X_new;
         for (int c = 0; c < 4; ++c) {
           X_old.col(c) = x_old[p.nodes[c]];
           X_new.col(c) = x_new[p.nodes[c]];
         }
-        hit[k] = dcr_detect(dcr_kind(p), X_old, X_new).penetrating ? 2 : 1;
+        if (first_round && !pair_boxes_overlap(p.kind, X_old, X_new)) {
+          hit[k] = 3;
+          continue;
+        }
+        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new).penetrating ? 2 : 1;
       }
     });
     std::vector<Index> found;
-    for (size_t k = 0; k < mine.size(); ++k) {
-      if (hit[k] == 2) found.push_back(mine[k]);
-      result.detected += hit[k] != 0;
+    if (first_round) kept.clear();
+    for (size_t k = 0; k < check.size(); ++k) {
+      if (hit[k] == 2) found.push_back(check[k]);
+      if (first_round && hit[k] != 3) kept.push_back(check[k]);
+      result.detected += hit[k] == 1 || hit[k] == 2;
     }
     if (gather) gather(found);
     first_round = false;

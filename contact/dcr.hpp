@@ -33,7 +33,7 @@ struct DcrResult {
   double dissipated = 0.0;  ///< kinetic energy lost by the impacts and friction, J
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
   Index unresolved = -1;    ///< when capped: the first pair (index into the pairs) found in the last round
-  Index detected = 0;       ///< pair detections run on this rank, summed over the rounds
+  Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds
 };
 
 /// Hands the pairs one rank found penetrating in a round to every rank: `found` (ascending
@@ -46,6 +46,7 @@ struct DcrScratch {
   std::vector<long> moved;  ///< per node: the last round stamp in which a pair moved it
   std::vector<Index> slot;  ///< per node: -1 (the coloring's compact numbering, reset after use)
   long stamp = 0;           ///< rounds started so far, over all calls
+  std::vector<Index> overlapping;  ///< out: the pairs of mine whose swept boxes overlap (last call)
 };
 
 /// Resolves the penetrations of one step (DESIGN.md step 2). Nodal arrays are indexed by
@@ -57,9 +58,10 @@ struct DcrScratch {
 ///   dt        the step length (s): x_new = x_old + dt v before contact.
 /// pairs is the candidate list (the same on every rank) and mine the indices of the pairs
 /// this rank checks, ascending. The work goes in rounds:
-///   1. detection: each pair of mine (in the first round) or each pair of mine with a node
-///      moved in the previous round (the others would be found clean again) is checked by
-///      dcr_detect, in parallel, reading only;
+///   1. detection, in parallel, reading only: in the first round each pair of mine whose swept
+///      boxes overlap (pair_boxes_overlap: the pairs a fresh search would give, kept in
+///      scratch.overlapping) is checked by dcr_detect; in later rounds each of those with a
+///      node moved in the previous round (the others would be found clean again);
 ///   2. the pairs found penetrating on every rank (gather) are colored greedily in ascending
 ///      pair order (pairs of one color share no node);
 ///   3. resolution: one Gauss-Seidel pass over the found pairs, color after color, the pairs of

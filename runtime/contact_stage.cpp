@@ -75,7 +75,12 @@ void ContactStage::search(std::span<const Vec3> x_old, std::span<const Vec3> x_n
   x_search_.assign(x_new.begin(), x_new.end());
   have_candidates_ = true;
   ++profile_.searches;
-  if (dec_) assign_pairs(x_new);
+  if (dec_) {
+    assign_pairs(x_new);
+  } else {
+    mine_.resize(pairs_.size());
+    std::iota(mine_.begin(), mine_.end(), 0);
+  }
 }
 
 // Ownership rule: a candidate belongs to the rank of its face (vertex-face) or of
@@ -129,8 +134,9 @@ void ContactStage::assign_pairs(std::span<const Vec3> x) {
     repartition_ = false;
     ++profile_.repartitions;
   }
-  pair_rank_.resize(pairs_.size());
-  for (size_t k = 0; k < pairs_.size(); ++k) pair_rank_[k] = primitive_rank_[primitive[k]];
+  mine_.clear();
+  for (size_t k = 0; k < pairs_.size(); ++k)
+    if (primitive_rank_[primitive[k]] == dec_->rank()) mine_.push_back(static_cast<Index>(k));
 }
 
 std::array<long, 3> ContactStage::owned_pairs_range() const {
@@ -143,8 +149,9 @@ std::array<long, 3> ContactStage::owned_pairs_range() const {
 }
 
 ContactPairs ContactStage::active_pairs() const {
-  ContactPairs out(mine_.size());
-  for (size_t k = 0; k < mine_.size(); ++k) out[k] = pairs_[mine_[k]];
+  const std::vector<Index>& kept = scratch_.overlapping;
+  ContactPairs out(kept.size());
+  for (size_t k = 0; k < kept.size(); ++k) out[k] = pairs_[kept[k]];
   return out;
 }
 
@@ -162,11 +169,6 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new);
   lap(profile_.search_seconds);
-  const int rank = dec_ ? dec_->rank() : 0;
-  mine_ = parallel_select(static_cast<Index>(pairs_.size()), [&](Index i) {
-    return (!dec_ || pair_rank_[i] == rank) && pair_boxes_overlap(pairs_[i], x_old, x_new);
-  });
-  lap(profile_.filter_seconds);
   DcrGather gather;
   if (dec_)
     gather = [&](std::vector<Index>& found) {
@@ -180,7 +182,7 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
   lap(profile_.sweep_seconds);
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());
-  profile_.owned_pairs += static_cast<long>(mine_.size());
+  profile_.owned_pairs += static_cast<long>(scratch_.overlapping.size());
   profile_.detections += r.detected;
   profile_.sweeps += r.sweeps;
   return r;

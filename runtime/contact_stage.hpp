@@ -39,8 +39,7 @@ namespace shatter {
 struct ContactProfile {
   double verlet_seconds = 0;    ///< checking that the candidates of the last search still serve
   double search_seconds = 0;    ///< the searches themselves
-  double filter_seconds = 0;    ///< the step's box test over this rank's candidates
-  double sweep_seconds = 0;     ///< DCR: detection, coloring and resolution rounds
+  double sweep_seconds = 0;     ///< DCR: box test and detection, coloring and resolution rounds
   long steps = 0, searches = 0;
   long candidates = 0;   ///< candidates of the search in force, summed over steps
   long owned_pairs = 0;  ///< this rank's candidates that passed the box test, summed over steps
@@ -78,9 +77,9 @@ class ContactStage {
   /// This rank's pairs that DCR checked in the last apply(): on one rank, equal to the
   /// pairs of a fresh search whose swept boxes overlap.
   ContactPairs active_pairs() const;
-  /// Seconds spent in the search (the reuse check and the step's filter
-  /// included) and in DCR (detection, coloring, resolution) so far; number of searches run.
-  double search_seconds() const { return profile_.verlet_seconds + profile_.search_seconds + profile_.filter_seconds; }
+  /// Seconds spent in the search (the reuse check included) and in DCR (the step's box test,
+  /// detection, coloring, resolution) so far; number of searches run.
+  double search_seconds() const { return profile_.verlet_seconds + profile_.search_seconds; }
   double dcr_seconds() const { return profile_.sweep_seconds; }
   long searches() const { return profile_.searches; }
   const ContactProfile& profile() const { return profile_; }
@@ -93,7 +92,7 @@ class ContactStage {
  private:
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   void search(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
-  /// Ranks of the new candidates; a new RCB partition when needed (the rule in contact_stage.cpp).
+  /// This rank's new candidates (mine_); a new RCB partition when needed (the rule in contact_stage.cpp).
   void assign_pairs(std::span<const Vec3> x);
 
   ContactSurface surface_;
@@ -102,7 +101,7 @@ class ContactStage {
   double margin_ = 0;
   bool have_candidates_ = false;
   ContactPairs pairs_;          ///< candidates of the last search (inflated boxes)
-  std::vector<Index> mine_;     ///< this step's pairs: this rank's pairs_ whose swept boxes overlap
+  std::vector<Index> mine_;     ///< this rank's candidates (indices into pairs_, ascending)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;
@@ -112,7 +111,6 @@ class ContactStage {
   std::vector<Index> triangle_order_;  ///< triangles sorted by their nodes (pair -> face)
   std::vector<int> primitive_rank_;    ///< rank of each triangle, then of each edge
   bool repartition_ = true;            ///< the surface changed: partition at the next search
-  std::vector<int> pair_rank_;         ///< rank of each candidate of pairs_
 };
 
 }  // namespace shatter

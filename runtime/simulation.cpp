@@ -730,7 +730,6 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
     const ContactProfile& cp = contact_->profile();
     const double steps = std::max(1L, cp.steps);
     j.add("contact_verlet_time", cp.verlet_seconds);
-    j.add("contact_filter_time", cp.filter_seconds);
     j.add("contact_sweep_time", cp.sweep_seconds);
     j.add("contact_candidates_per_step", cp.candidates / steps);
     j.add("contact_pairs_per_step", owned_pairs[2] / steps);

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <random>
 
+#include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
 #include "kernels/error.hpp"
 #include "expect_close.hpp"
@@ -275,7 +276,7 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
         X_new.col(k) = split.x_new[p.nodes[k]];
       }
       const auto kind = p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
-      if (dcr_detect(kind, X_old, X_new).penetrating) found.push_back(i);
+      if (pair_boxes_overlap(p.kind, X_old, X_new) && dcr_detect(kind, X_old, X_new).penetrating) found.push_back(i);
     }
     std::sort(found.begin(), found.end());
   });
