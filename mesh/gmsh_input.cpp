@@ -9,11 +9,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <limits>
-#include <map>
 #include <mutex>
 #include <numbers>
-#include <set>
 #include <sstream>
 #include <unordered_map>
 
@@ -286,26 +283,24 @@ class MshScan {
       if (!(in_ >> token)) cut(section);
   }
 
-  /// Nodes per element of Gmsh element `type` (Gmsh's own table).
-  int nodes_of(std::uint64_t type, std::uint64_t tag) {
-    const auto known = nodes_.find(type);
-    if (known != nodes_.end()) return known->second;
-    std::string name;
-    int dim = 0, order = 0, nodes = 0, primary = 0;
-    std::vector<double> local;
-    if (type <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())) try {
-        gmsh::model::mesh::getElementProperties(static_cast<int>(type), name, dim, order, nodes,
-                                                local, primary);
-      } catch (...) {  // Gmsh 4.8 throws a bare value for an unknown type
-        nodes = 0;
-      }
-    if (nodes <= 0)
+  /// Nodes per element of Gmsh element `type`: the types of the Gmsh
+  /// reference manual's MSH list (1-31, 92, 93). Gmsh's own table
+  /// (getElementProperties) builds each type's nodal basis, and for prisms
+  /// Gmsh 4.8 frees memory with the wrong operator (found by fuzz_msh).
+  int nodes_of(std::uint64_t type, std::uint64_t tag) const {
+    static constexpr int kNodes[32] = {0, 2,  3,  4,  4, 8,  6,  5,  3,  6,  9, 10, 27, 18, 14, 1,
+                                       8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4, 5,  6,  20, 35, 56};
+    const int nodes = type < 32 ? kNodes[type] : type == 92 ? 64 : type == 93 ? 125 : 0;
+    if (nodes == 0)
       fail("holds element " + std::to_string(tag) + " of type " + std::to_string(type) +
-           ", which Gmsh does not know; expected Gmsh element types (4: 4-node tetrahedron, 11: "
-           "10-node)");
-    nodes_[type] = nodes;
-    if (dim == 3 && primary == 4) tetrahedra_.insert(type);
+           ", which is not a Gmsh element type; expected the types of the Gmsh reference "
+           "manual (4: 4-node tetrahedron, 11: 10-node)");
     return nodes;
+  }
+
+  /// Tetrahedra of orders 1 to 5 (the manual's types 4, 11, 29, 30, 31).
+  static bool tetrahedron(std::uint64_t type) {
+    return type == 4 || type == 11 || type == 29 || type == 30 || type == 31;
   }
 
   void record(std::uint64_t type, std::uint64_t count, std::uint64_t first_tag) {
@@ -315,8 +310,8 @@ class MshScan {
     if (it == types_.end()) {
       MshElementType t;
       t.type = static_cast<int>(type);
-      t.nodes = nodes_[type];
-      t.tetrahedron = tetrahedra_.count(type) > 0;
+      t.nodes = nodes_of(type, first_tag);
+      t.tetrahedron = tetrahedron(type);
       t.first_tag = first_tag;
       it = types_.insert(types_.end(), t);
     }
@@ -437,16 +432,12 @@ class MshScan {
   std::ifstream in_;
   std::uint64_t size_ = 0;
   bool v41_ = false, binary_ = false, swap_ = false;
-  std::map<std::uint64_t, int> nodes_;
-  std::set<std::uint64_t> tetrahedra_;
   std::vector<MshElementType> types_;
 };
 
 }  // namespace
 
 std::vector<MshElementType> scan_msh_elements(const std::string& path, const std::string& where) {
-  std::lock_guard lock(gmsh_mutex());
-  GmshSession session;  // Gmsh's table of element types
   return MshScan(path, where).run();
 }
 

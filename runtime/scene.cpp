@@ -115,6 +115,10 @@ YAML::Node walk(YAML::Node root, const std::string& path, const std::string& fil
     std::size_t j = path.find_first_of(".[", i);
     const std::string name = path.substr(i, j == std::string::npos ? std::string::npos : j - i);
     if (name.empty()) bad("expected a key path like time.safety or bodies[0].mesh.element_size");
+    // yaml-cpp throws its own exception for a key into a value or a list.
+    if (node.IsScalar() || node.IsSequence())
+      bad("'" + (i == 0 ? std::string("(top level)") : path.substr(0, i - 1)) +
+          "' is not a mapping");
     node.reset(node[name]);
     i = j == std::string::npos ? path.size() : j;
     while (i < path.size() && path[i] == '[') {

@@ -362,6 +362,6 @@ TEST(GmshInput, ScanRefusesWhatItCannotFollow) {
                 .find("cut short or malformed in its $Elements section"),
             std::string::npos);
   EXPECT_NE(refusal("type.msh", head + "1\n9 777 0 1 2 3\n$EndElements\n")
-                .find("holds element 9 of type 777, which Gmsh does not know"),
+                .find("holds element 9 of type 777, which is not a Gmsh element type"),
             std::string::npos);
 }
