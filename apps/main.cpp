@@ -13,10 +13,14 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
+#include "runtime/failure.hpp"
 #include "runtime/model.hpp"
 #include "runtime/report.hpp"
 #include "runtime/scene.hpp"
@@ -77,11 +81,25 @@ int plot_outputs(const std::string& out_dir) {
   return WEXITSTATUS(wstatus);
 }
 
-}  // namespace
+/// The one message of a failure and the exit status (runtime/failure.hpp):
+/// when every rank failed, rank 0 prints it; a rank that failed alone prints
+/// it and ends every rank with MPI_Abort.
+int report_failure(FailureChannel& failures, int status, const char* message, int rank, int ranks) {
+  const FailureAgreement a = failures.agree(status);
+  if (!a.all_ranks) {
+    std::fprintf(stderr,
+                 "error: %s\n(rank %d of %d failed alone while the others waited in a collective: "
+                 "every rank is ended with MPI_Abort; no checkpoint of this failure, an earlier "
+                 "one stays)\n",
+                 message, rank, ranks);
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, status);
+  }
+  if (rank == 0) std::fprintf(stderr, "error: %s\n", message);
+  return a.status;
+}
 
-int main(int argc, char** argv) {
-  int provided = 0;
-  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+int cli(int argc, char** argv, FailureChannel& failures) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
@@ -107,53 +125,64 @@ int main(int argc, char** argv) {
   auto* plot = app.add_subcommand("plot", "plot a run's history.csv into OUTDIR/plots/ (PNG)");
   plot->add_option("outdir", out_dir, "output folder of a run")->required();
 
-  int status = 0;
+  // Outside the try block: a failure is reported (and, on one rank alone,
+  // ends the process) before the simulation's collective destructors run.
+  std::optional<Model> model;
+  std::unique_ptr<Simulation> sim;
   try {
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
       // --help and --version exit 0 through CLI11; a bad command line is bad input.
       const int rc = e.get_exit_code() == 0 ? app.exit(e) : 2;
-      if (rc != 0 && rank == 0) std::fprintf(stderr, "error: %s (shatter --help shows the usage)\n", e.what());
-      MPI_Finalize();
+      if (rc != 0 && rank == 0)
+        std::fprintf(stderr, "error: %s (shatter --help shows the usage)\n", e.what());
       return rc == 0 ? 0 : 2;
     }
-    if (*plot) {
-      status = rank == 0 ? plot_outputs(out_dir) : 0;
-      MPI_Finalize();
-      return status;
-    }
+    if (*plot) return rank == 0 ? plot_outputs(out_dir) : 0;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     const Scene scene = load_scene(scene_path, overrides);
-    Model model = build_model(scene);
+    model = build_model(scene);
     RunOptions opt;
     opt.threads = threads;
     opt.ranks = ranks;
     opt.quiet = quiet;
     opt.deterministic = deterministic;
+    opt.failures = &failures;
+    if (const char* fail = std::getenv("SHATTER_TEST_FAIL"))
+      if (std::sscanf(fail, "%d:%ld", &opt.fail_rank, &opt.fail_step) != 2)
+        throw InputError(std::string("SHATTER_TEST_FAIL=") + fail + ": expected RANK:STEP");
     if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
     // A restart continues the outputs beside its checkpoint unless --out says otherwise.
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
-    Simulation sim(model, opt);
-    if (!restart.empty()) sim.restore_state(read_checkpoint(restart, model));
+    sim = std::make_unique<Simulation>(*model, opt);
+    if (!restart.empty()) sim->restore_state(read_checkpoint(restart, *model));
     if (*check) {
-      print_check(model, sim);
+      print_check(*model, *sim);
     } else {
       install_stop_handlers();
-      const long steps = sim.run();
+      const long steps = sim->run();
       if (!quiet && rank == 0)
         std::fprintf(stderr, "done: %ld steps, energy error %.2e; outputs in %s\n", steps,
-                     sim.energy_error(), opt.out_dir.c_str());
+                     sim->energy_error(), opt.out_dir.c_str());
     }
   } catch (const InputError& e) {
-    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
-    status = 2;
-  } catch (const Error& e) {
-    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
-    status = 1;
+    return report_failure(failures, 2, e.what(), rank, ranks);
   } catch (const std::exception& e) {
-    if (rank == 0) std::fprintf(stderr, "error: %s\n", e.what());
-    status = 1;
+    return report_failure(failures, 1, e.what(), rank, ranks);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  int status = 0;
+  {
+    FailureChannel failures(MPI_COMM_WORLD);
+    status = cli(argc, argv, failures);
   }
   MPI_Finalize();
   return status;

@@ -60,7 +60,7 @@ std::vector<Index> FractureStage::cohesive_nodes() const {
 
 double FractureStage::stable_dt(double element_dt, std::span<const double> mass) {
   if (cohesive_.size() == 0) return element_dt;
-  const std::array<Index, 2> key = {cohesive_.size(), model_.mesh.num_nodes()};
+  const std::array<Index, 3> key = {cohesive_.size(), model_.mesh.num_nodes(), released_};
   if (key != bound_key_) {
     eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws_, mass);
     bound_key_ = key;
@@ -71,7 +71,9 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
 
 Index FractureStage::release() {
   if (cohesive_.size() == 0) return 0;
-  return release_debonded(model_.mesh, topology_, cohesive_, laws_);
+  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_);
+  released_ += freed;
+  return freed;
 }
 
 void FractureStage::save(FractureState& s) const {
@@ -134,6 +136,7 @@ void FractureStage::restore(const FractureState& s) {
   model_.initial_velocity = s.initial_velocity;
   topology_.facet_state = s.facet_state;
   cohesive_ = s.cohesive;
+  bound_key_ = {-1, -1, -1};  // the cohesive elements changed: compute the bound afresh
 }
 
 }  // namespace shatter

@@ -99,8 +99,12 @@ class FractureStage {
   CohesiveElements cohesive_;
   std::vector<std::optional<CohesiveLaw>> laws_;
   double check_seconds_ = 0;
-  double eigenvalue_bound_ = 0;                   ///< cached cohesive bound, 1/s^2
-  std::array<Index, 2> bound_key_ = {-1, -1};     ///< (cohesive count, node count) it was computed for
+  double eigenvalue_bound_ = 0;  ///< cached cohesive bound, 1/s^2
+  Index released_ = 0;           ///< cohesive elements freed by release() so far
+  /// (cohesive count, node count, released_) the bound was computed for: what
+  /// it depends on, so that it always equals a fresh one (a restored run, which
+  /// computes it afresh, takes the same steps)
+  std::array<Index, 3> bound_key_ = {-1, -1, -1};
 };
 
 }  // namespace shatter

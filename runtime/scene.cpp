@@ -41,7 +41,7 @@ class Reader {
     if (!map.IsMap()) fail(key.empty() ? "(top level)" : key, "a mapping", map);
     std::set<std::string> ok(allowed.begin(), allowed.end());
     for (const auto& kv : map) {
-      const std::string k = kv.first.as<std::string>();
+      const std::string k = string(kv.first, join(key, "(key)"));
       if (!ok.count(k)) {
         std::string list;
         for (const auto& a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
@@ -115,6 +115,10 @@ YAML::Node walk(YAML::Node root, const std::string& path, const std::string& fil
     std::size_t j = path.find_first_of(".[", i);
     const std::string name = path.substr(i, j == std::string::npos ? std::string::npos : j - i);
     if (name.empty()) bad("expected a key path like time.safety or bodies[0].mesh.element_size");
+    // yaml-cpp throws its own exception for a key into a value or a list.
+    if (node.IsScalar() || node.IsSequence())
+      bad("'" + (i == 0 ? std::string("(top level)") : path.substr(0, i - 1)) +
+          "' is not a mapping");
     node.reset(node[name]);
     i = j == std::string::npos ? path.size() : j;
     while (i < path.size() && path[i] == '[') {
@@ -243,7 +247,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
   if (!mats.IsMap() || mats.size() == 0) r.fail("materials", "a mapping of material names to materials", mats);
   for (const auto& kv : mats) {
     MaterialSpec m;
-    m.name = kv.first.as<std::string>();
+    m.name = r.string(kv.first, "materials.(name)");
     const std::string key = "materials." + m.name;
     const YAML::Node n = kv.second;
     r.only_keys(n, key, {"model", "density", "youngs_modulus", "poisson_ratio", "fracture"});

@@ -11,6 +11,7 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/contact_stage.hpp"
 #include "runtime/decomposition.hpp"
+#include "runtime/failure.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/parallel.hpp"
@@ -201,6 +202,9 @@ void Simulation::compute_forces(long step, double time, const std::function<void
 }
 
 void Simulation::step() {
+  if (step_ + 1 == opt_.fail_step && dec_->rank() == opt_.fail_rank)
+    throw Error("step " + std::to_string(step_ + 1) + ": failure injected on rank " +
+                std::to_string(opt_.fail_rank) + " by SHATTER_TEST_FAIL");
   dt_ = next_dt();
   const double dt = dt_, half = 0.5 * dt;
   const Index n = model_.mesh.num_nodes();
@@ -605,9 +609,13 @@ long Simulation::run() {
     if (checkpoints) save_state(good);
     try {
       step();
-    } catch (const Error& e) {
+    } catch (const std::exception& e) {
       if (!checkpoints) throw;
       progress.finish();
+      // On several ranks the state is saved only when every rank failed in
+      // this step; a failure of this rank alone leaves the others in a
+      // collective, and the CLI aborts them all.
+      if (dec_->distributed() && opt_.failures && !opt_.failures->agree(1).all_ranks) throw;
       try {
         save_checkpoint(checkpoint, good, e.what());
       } catch (const Error& w) {

@@ -24,6 +24,7 @@
 namespace shatter {
 
 class FieldWriter;
+class FailureChannel;
 class CsvWriter;
 class ContactStage;
 class Decomposition;
@@ -36,6 +37,15 @@ struct RunOptions {
   int ranks = 1;
   bool quiet = false;
   bool deterministic = false;
+  /// Several ranks: the ranks agree through it whether a failed step failed on
+  /// every rank (then the last good state is checkpointed) or on this one
+  /// alone (then it cannot be, runtime/failure.hpp). Null: every failure is
+  /// taken as collective.
+  FailureChannel* failures = nullptr;
+  /// A test of the failure path (SHATTER_TEST_FAIL=RANK:STEP in the CLI): step
+  /// `fail_step` throws Error on rank `fail_rank` only.
+  int fail_rank = -1;
+  long fail_step = 0;
 };
 
 /// The energy and momentum ledger of SCENE.md (history.csv columns), SI units.

@@ -96,6 +96,14 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
                                        << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
                                           "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
   std::ofstream(dir / "garbage.msh") << "this is not a mesh\n";
+  std::ofstream(dir / "v40.msh") << "$MeshFormat\n4 0 8\n$EndMeshFormat\n";
+  std::ofstream(dir / "cut.msh") << header << "$Elements\n2\n1 4 2 1 1 1 2 3 4\n";
+  std::ofstream(dir / "unknown_type.msh") << header << "$Elements\n1\n3 777 0 1 2 3\n$EndElements\n";
+  std::ofstream(dir / "mixed.msh") << header
+                                   << "$Nodes\n10\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0.5 0 0\n6 0.5 0.5 0\n"
+                                      "7 0 0.5 0\n8 0 0 0.5\n9 0 0.5 0.5\n10 0.5 0 0.5\n$EndNodes\n"
+                                      "$Elements\n2\n1 4 2 1 1 1 2 3 4\n2 11 2 1 1 1 2 3 4 5 6 7 8 9 10\n"
+                                      "$EndElements\n";
   std::ofstream(dir / "bad_yaml.yaml") << "name: x\ntime: [1, 2\n";
   std::ofstream(dir / "list.yaml") << "- name: x\n- time: 1\n";
   std::ofstream(dir / "not_hdf5.h5") << "this is not a checkpoint\n";

@@ -1,0 +1,65 @@
+#!/bin/bash
+# A failure on any rank ends the run on every rank with one message (issue 6,
+# docs/errors.md "On several ranks"), on 2 ranks:
+#   - rank 1 alone fails inside the time loop (SHATTER_TEST_FAIL=1:5) while
+#     rank 0 goes on into the step's collectives: exit 1, one error line;
+#   - rank 0 alone fails (history.csv on a full disk: /dev/full) while rank 1
+#     waits in the first ledger reduction: exit 1, one error line;
+#   - every rank fails together (elements inverted by a step far above the
+#     stable one): exit 1, one error line, the last good state checkpointed;
+#   - bad input on every rank: exit 2, one error line.
+# A hang is caught by `timeout` (and ctest's TIMEOUT).
+# usage: failures.sh SHATTER MPIEXEC WORKDIR
+set -uo pipefail
+shatter=$1 mpiexec=$2 work=$3
+rm -rf "$work"
+mkdir -p "$work"
+cat > "$work/box.yaml" <<'YAML'
+name: box
+time: {end: 2.0e-5}
+output: {every: 0, history_every: 5}
+materials:
+  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}
+bodies:
+  - name: b
+    material: steel
+    mesh: {shape: box, size: [0.02, 0.01, 0.01], element_size: 0.002}
+    initial_velocity: [1, 0, 0]
+    angular_velocity: [0, 0, 300]
+YAML
+fail=0
+# run NAME STATUS MESSAGE [env and arguments]: runs shatter on 2 ranks, checks
+# the exit status and that exactly one line starts with "error: ", that line
+# containing MESSAGE.
+run() {
+  local name=$1 want=$2 message=$3
+  shift 3
+  timeout -k 10 100 env "$@" > "$work/$name.log" 2>&1
+  local status=$?
+  local errors
+  errors=$(grep -c '^error: ' "$work/$name.log")
+  if [ "$status" -ne "$want" ] || [ "$errors" -ne 1 ] || ! grep '^error: ' "$work/$name.log" | grep -qF -- "$message"; then
+    echo "FAIL $name: exit $status (expected $want), $errors error lines (expected 1 with '$message'):"
+    cat "$work/$name.log"
+    fail=1
+  else
+    echo "ok $name: exit $status, one message: $(grep '^error: ' "$work/$name.log")"
+  fi
+}
+mpi=("$mpiexec" --allow-run-as-root --oversubscribe -n 2 "$shatter" run "$work/box.yaml" --threads 1 --quiet)
+
+run lone_rank1 1 "error: step 5: failure injected on rank 1 by SHATTER_TEST_FAIL" \
+  SHATTER_TEST_FAIL=1:5 "${mpi[@]}" --out "$work/lone_rank1"
+grep -q "rank 1 of 2 failed alone" "$work/lone_rank1.log" || { echo "FAIL lone_rank1: no note of the lone failure"; fail=1; }
+
+mkdir -p "$work/full"
+ln -s /dev/full "$work/full/history.csv"
+run lone_rank0 1 "history.csv" "${mpi[@]}" --out "$work/full"
+grep -q "rank 0 of 2 failed alone" "$work/lone_rank0.log" || { echo "FAIL lone_rank0: no note of the lone failure"; fail=1; }
+
+run collective 1 "is inverted" "${mpi[@]}" --out "$work/collective" --set time.dt=2.0e-6 --set time.end=1.0e-3
+grep -q "the last good state (step " "$work/collective.log" && [ -f "$work/collective/checkpoint.h5" ] ||
+  { echo "FAIL collective: no checkpoint of the last good state"; fail=1; }
+
+run bad_input 2 "time.end: expected a positive number, got 'soon'" "${mpi[@]}" --out "$work/bad" --set time.end=soon
+exit $fail
