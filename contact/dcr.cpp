@@ -29,6 +29,21 @@ Index contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets,
   return n_slots;
 }
 
+std::vector<Vec3> contact_pair_normals(const ContactPairs& pairs, const ContactSurface& surface,
+                                       const VertexTriangles& around, std::span<const Vec3> x) {
+  std::vector<Vec3> normals(2 * pairs.size());
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, pairs.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+          const auto& n = pairs[i].nodes;
+          const bool vf = pairs[i].kind == ContactPair::VertexFace;
+          normals[2 * i] = surface_normal(surface, around, x, n[0], vf ? -1 : n[1]);
+          normals[2 * i + 1] = vf ? Vec3::Zero() : surface_normal(surface, around, x, n[2], n[3]);
+        }
+      });
+  return normals;
+}
+
 namespace {
 
 bool distinct_nodes(const ContactPair& p) {
@@ -52,8 +67,10 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
                       colors.offsets.back() == static_cast<Index>(pairs.size()),
                   "resolve_contacts: the coloring covers " << colors.items.size() << " items, not the "
                                                            << pairs.size() << " pairs");
-  SHATTER_REQUIRE(colors.slots.size() == 4 * pairs.size(),
-                  "resolve_contacts: " << colors.slots.size() << " node slots for " << pairs.size() << " pairs");
+  SHATTER_REQUIRE(
+      colors.slots.size() == 4 * pairs.size() && colors.normals.size() == 2 * pairs.size(),
+      "resolve_contacts: " << colors.slots.size() << " node slots and " << colors.normals.size()
+                           << " normals for " << pairs.size() << " pairs");
   SHATTER_REQUIRE(!remote || remote->owner.size() == pairs.size(),
                   "resolve_contacts: " << remote->owner.size() << " pair owners for " << pairs.size() << " pairs");
   SHATTER_REQUIRE(dt > 0, "resolve_contacts: step length dt = " << dt << " s");
@@ -83,6 +100,8 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
       if (last_move < sweep - 1) return;
     }
     PairPoints X_old, X_new, V;
+    PairNormals N;
+    N << colors.normals[2 * i], colors.normals[2 * i + 1];
     PairWeights w;
     for (int k = 0; k < 4; ++k) {
       const Index n = pair.nodes[k];
@@ -92,7 +111,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
       w[k] = inv_mass[n];
     }
     const auto kind = pair.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
-    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, w, law, 0.5 * dt);
+    const DcrPairResponse r = dcr_resolve_pair(kind, X_old, X_new, V, N, w, law, 0.5 * dt);
     if (!r.active) return;
     active_now[i] = 1;
     ever_active[i] = 1;

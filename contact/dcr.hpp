@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "contact/pairs.hpp"
+#include "contact/surface.hpp"
 #include "kernels/dcr.hpp"
 
 namespace shatter {
@@ -41,11 +42,14 @@ struct DcrResult {
 /// and no two of them share a node. Every pair index appears exactly once.
 /// slots: the CSR's compact node numbers (four per pair), num_slots of them, so that the
 /// sweeps' per-node bookkeeping is sized by the pairs' nodes, not by the mesh.
+/// normals: two per pair, the outward surface normals at the start of the step by which DCR
+/// tells touching from penetrating (contact_pair_normals, kernels/dcr.hpp PairNormals).
 struct DcrPairColors {
   std::span<const Index> offsets;
   std::span<const Index> items;
   std::span<const Index> slots;
   Index num_slots = 0;
+  std::span<const Vec3> normals;
 };
 
 /// The pair -> node CSR to color, the nodes numbered compactly: pair i's nodes are
@@ -55,6 +59,12 @@ struct DcrPairColors {
 /// and left so: the cost is O(pairs), whatever the mesh size. Returns the number of slots.
 Index contact_pair_nodes(const ContactPairs& pairs, std::vector<Index>& offsets, std::vector<Index>& slots,
                          std::vector<Index>& node_slot);
+
+/// The outward surface normals of each pair at x (surface_normal), two per pair in pair order,
+/// for DcrPairColors::normals: a vertex-face pair's vertex normal (and 0), an edge-edge pair's
+/// normals of edge a and edge b (the sums over their triangles). O(pairs).
+std::vector<Vec3> contact_pair_normals(const ContactPairs& pairs, const ContactSurface& surface,
+                                       const VertexTriangles& around, std::span<const Vec3> x);
 
 /// The pairs resolved elsewhere (other MPI ranks: runtime/contact_stage.cpp). Pair i belongs
 /// to rank owner[i]; resolve_contacts resolves the pairs of `rank` and hands the ones it found

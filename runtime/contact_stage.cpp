@@ -30,6 +30,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
 
 void ContactStage::rebuild(const Mesh& mesh) {
   surface_ = build_contact_surface(mesh);
+  vertex_triangles_ = vertex_triangles(surface_);
   std::vector<double> lengths;
   lengths.reserve(surface_.edges.size());
   for (const auto& [a, b] : surface_.edges) lengths.push_back((mesh.reference[a] - mesh.reference[b]).norm());
@@ -192,8 +193,10 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
   node_slot_.resize(x_new.size(), -1);
   const Index slots = contact_pair_nodes(active_, pair_offsets_, pair_slots_, node_slot_);
   const Coloring colors = greedy_coloring(pair_offsets_, pair_slots_, slots);
+  const std::vector<Vec3> normals =
+      contact_pair_normals(active_, surface_, vertex_triangles_, x_old);
   lap(profile_.coloring_seconds);
-  const DcrPairColors dcr_colors{colors.offsets, colors.items, pair_slots_, slots};
+  const DcrPairColors dcr_colors{colors.offsets, colors.items, pair_slots_, slots, normals};
   DcrResult r;
   if (!dec_) {
     r = resolve_contacts(active_, x_new, x_old, v, inv_mass, dt, options_, dcr_colors);

@@ -40,7 +40,8 @@ struct ContactProfile {
   double verlet_seconds = 0;    ///< checking that the candidates of the last search still serve
   double search_seconds = 0;    ///< the searches themselves
   double filter_seconds = 0;    ///< the step's box test over the candidates
-  double coloring_seconds = 0;  ///< node slots and the coloring of the step's pairs
+  double coloring_seconds =
+      0;  ///< node slots, the coloring of the step's pairs and their nodes' normals
   double sweep_seconds = 0;     ///< the DCR sweeps
   long steps = 0, searches = 0;
   long candidates = 0;    ///< candidates of the search in force, summed over steps
@@ -97,6 +98,7 @@ class ContactStage {
   void gather_active(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
 
   ContactSurface surface_;
+  VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;

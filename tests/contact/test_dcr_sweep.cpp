@@ -35,6 +35,8 @@ struct Stack {
   std::vector<double> inv_mass;
   std::vector<std::pair<Sheet, Sheet>> contacts;  // (lower top sheet, upper bottom sheet)
   ContactPairs pairs;
+  std::vector<SurfaceTriangle>
+      triangles;  // every sheet's, for the outward normals (none: no normals)
 };
 
 Sheet make_sheet(Stack& s, int n, Vec3 origin, bool outside_up, const Vec3& velocity, double inv_mass_scale,
@@ -59,6 +61,8 @@ Sheet make_sheet(Stack& s, int n, Vec3 origin, bool outside_up, const Vec3& velo
       if (!outside_up) std::swap(t0[1], t0[2]), std::swap(t1[1], t1[2]);
       sheet.triangles.push_back(t0);
       sheet.triangles.push_back(t1);
+      s.triangles.push_back({t0, 0});
+      s.triangles.push_back({t1, 0});
     }
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
@@ -127,6 +131,8 @@ Stack make_stack(int bodies, int n, bool fixed_ground, std::uint64_t seed, bool 
     const Vec3 shift(0.37 * k - std::floor(0.37 * k), 0.23 * k - std::floor(0.23 * k), 0);
     if (thin) {
       const Sheet sheet = make_sheet(s, n, Vec3(0, 0, 0.2 * k) + shift, true, velocity, 1.0, rng);
+      for (const auto& t : flipped(sheet).triangles)
+        s.triangles.push_back({t, 0});  // its underside
       add_candidates(s, below, flipped(sheet));
       s.contacts.emplace_back(below, sheet);
       below = sheet;
@@ -195,11 +201,13 @@ int count_penetrations(const Stack& s, const std::vector<Vec3>& x) {
   return bad;
 }
 
-/// A coloring of the pairs with their compact node slots.
+/// A coloring of the pairs with their compact node slots and outward normals: from the
+/// stack's sheets (on a thin sheet both sides cancel: none), or none.
 struct PairColoring : Coloring {
   std::vector<Index> slots;
   Index num_slots = 0;
-  DcrPairColors dcr() const { return {offsets, items, slots, num_slots}; }
+  std::vector<Vec3> normals;
+  DcrPairColors dcr() const { return {offsets, items, slots, num_slots, normals}; }
 };
 
 PairColoring color_pairs(const Stack& s) {
@@ -207,6 +215,12 @@ PairColoring color_pairs(const Stack& s) {
   PairColoring c;
   c.num_slots = contact_pair_nodes(s.pairs, offsets, c.slots, node_slot);
   static_cast<Coloring&>(c) = greedy_coloring(offsets, c.slots, c.num_slots);
+  if (s.triangles.empty()) {
+    c.normals.assign(2 * s.pairs.size(), Vec3::Zero());
+  } else {
+    const ContactSurface surface = make_contact_surface(s.triangles);
+    c.normals = contact_pair_normals(s.pairs, surface, vertex_triangles(surface), s.x_old);
+  }
   return c;
 }
 
@@ -368,5 +382,11 @@ TEST(DcrSweep, RejectsInconsistentInput) {
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
   EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, c.dcr()), Error);
   const std::vector<Index> no_items;
-  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {c.offsets, no_items, c.slots, c.num_slots}), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {},
+                                {c.offsets, no_items, c.slots, c.num_slots, c.normals}),
+               Error);
+  const std::vector<Vec3> no_normals;
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {},
+                                {c.offsets, c.items, c.slots, c.num_slots, no_normals}),
+               Error);
 }
