@@ -75,7 +75,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<Vec3> x_new, std
                   "resolve_contacts: " << remote->owner.size() << " pair owners for " << pairs.size() << " pairs");
   SHATTER_REQUIRE(dt > 0, "resolve_contacts: step length dt = " << dt << " s");
   SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
-  const DcrLaw law{options.restitution, options.friction, options.gap, options.mid_step};
+  const DcrLaw law{options.restitution, options.friction, options.gap, options.placement};
 
   // Per-pair accumulators, summed in pair order at the end: the totals do not depend on
   // which thread ran which pair.

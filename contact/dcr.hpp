@@ -24,7 +24,7 @@ struct DcrOptions {
   double friction = 0.0;     ///< Coulomb mu >= 0
   double gap = 1e-6;         ///< separation after projection, fraction of the pair's longest edge
   int max_sweeps = 100;      ///< cap on Gauss-Seidel sweeps; reaching it sets DcrResult::capped
-  bool mid_step = false;     ///< collision in the middle of the step (DcrLaw::mid_step)
+  DcrPlacement placement = DcrPlacement::End;  ///< where in the step a collision is placed (DcrLaw)
 };
 
 /// Summary of one call of resolve_contacts.

@@ -28,8 +28,8 @@
 //   3. momentum decomposition (dcr_impulse), [CW] sec. 3-4: normal part
 //      v_n = grad g . v / (grad g . W grad g), v' = v - (1 + e) v_n W grad g,
 //      then Coulomb friction as a second decomposition along a slide direction;
-//   dcr_resolve_pair places the collision at the end of the step (2 then 3, [CW])
-//   or in the middle (3 at the mid-step configuration, 2 only for what is left).
+//   dcr_resolve_pair places the collision at the end of the step (2 then 3, [CW]),
+//   in the middle or at the contact time t* (3 there, 2 only for what is left).
 // Pure functions: no allocation, no threads, no I/O.
 #include <algorithm>
 #include <array>
@@ -51,14 +51,20 @@ using PairWeights = Eigen::Vector4d;
 
 enum class DcrPairKind : std::uint8_t { VertexFace = 0, EdgeEdge = 1 };
 
+/// Where in the step dcr_resolve_pair places a collision (scene key contact.placement).
+enum class DcrPlacement : std::uint8_t {
+  End = 0,     ///< projection, then the impulse at the end of the step ([CW])
+  Middle = 1,  ///< the impulse at the mid-step configuration
+  Impact = 2,  ///< the impulse at the configuration of the contact time t*
+};
+
 /// Contact law of the DCR response.
 struct DcrLaw {
   double restitution = 1.0;  ///< e in [0, 1]: 1 = elastic, 0 = perfectly plastic
   double friction = 0.0;     ///< Coulomb coefficient mu >= 0
   double gap = 1e-6;         ///< separation left after projection, as a fraction of the
                              ///< pair's longest edge (dimensionless)
-  bool mid_step = false;     ///< collision placement: false = end of the step, true = middle
-                             ///< (dcr_resolve_pair)
+  DcrPlacement placement = DcrPlacement::End;  ///< dcr_resolve_pair
 };
 
 /// A distance below kDcrTouchTolerance L (L the pair's longest edge) counts as touching:
@@ -443,23 +449,25 @@ struct DcrPairResponse {
 /// One DCR resolution of a pair over a step of the central-difference predictor
 /// X_new = X_old + dt V (V the mid-step velocity, half_dt = dt / 2): detect (dcr_detect on
 /// X_old -> X_new, N the pair's outward normals); if the pair penetrates, resolve it with the
-/// collision placed
-///  - at the end of the step (law.mid_step false, [CW]'s impact time approximation):
-///    project X_new (dcr_project, direction from the configuration at t*), then the impulse
-///    at the projected positions (dcr_impulse);
-///  - in the middle of the step (law.mid_step true): a free flight to X_mid = X_new - half_dt V,
-///    the impulse there, a free flight on: V' = V + dV (dcr_impulse at X_mid),
-///    X_new += half_dt dV; then dcr_project only if the pair is still closer than the gap.
-/// Why the middle: a velocity change dv at the mid step that moves x(n+1) by dx changes the
-/// central-difference total energy by about f(n+1) . (half_dt dv - dx) besides the impulse's
-/// own kinetic-energy balance, which dx = half_dt dv cancels (the end placement has
-/// dx ~ (1 - t*) half_dt dv and loses t* half_dt f . dv per impact); and an impulse that is a
-/// gradient of rotation-invariant functions at X_mid between two free flights keeps
-/// sum m v and sum x x m v exactly. X_mid = X_new - half_dt V is kept by the update, so
-/// repeated resolutions of the pair in a step act at the same configuration. The final
-/// projection (at fixed velocities) is the exception that moves angular momentum and energy:
-/// it is needed when the impulse alone does not separate the pair (e < 1, pairs coupled
-/// through shared nodes, strongly curved g(t)). X_new and V are updated in place.
+/// collision placed (law.placement)
+///  - End: at the end of the step ([CW]'s impact time approximation): project X_new
+///    (dcr_project, direction from the configuration at t*), then the impulse at the projected
+///    positions (dcr_impulse);
+///  - Middle / Impact: at a time tau before the end of the step, tau = half_dt (Middle) or
+///    (1 - t*) dt (Impact, the contact time): a free flight back to X_c = X_new - tau V, the
+///    impulse there, a free flight on: V' = V + dV (dcr_impulse at X_c), X_new += tau dV;
+///    then dcr_project only if the pair is still closer than the gap.
+/// A velocity change dv at the mid step that moves x(n+1) by dx changes the central-difference
+/// total energy by about f(n+1) . (half_dt dv - dx) besides the impulse's own kinetic-energy
+/// balance: End has dx ~ (1 - t*) half_dt dv and loses t* half_dt f . dv per impact, Middle
+/// has dx = half_dt dv (no first-order term), Impact dx = (1 - t*) dt dv (a term
+/// (t* - 1/2) dt f . dv, of either sign). An impulse that is a gradient of rotation-invariant
+/// functions at X_c between two free flights keeps sum m v and sum x x m v exactly, whatever
+/// tau. X_c = X_new - tau V is kept by the update, so repeated resolutions of the pair in a
+/// step with the same tau act at the same configuration. The final projection (at fixed
+/// velocities) is the exception that moves angular momentum and energy: it is needed when the
+/// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
+/// strongly curved g(t)). X_new and V are updated in place.
 inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old,
                                         PairPoints& X_new, PairPoints& V, const PairNormals& N,
                                         const PairWeights& inv_mass, const DcrLaw& law,
@@ -470,22 +478,30 @@ inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_ol
   out.active = true;
   const double s = pen.orientation;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
-  if (!law.mid_step) {
+  if (law.placement == DcrPlacement::End) {
     out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap);
     out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
     return out;
   }
-  const PairPoints X_mid = X_new - half_dt * V;
+  const double tau =
+      law.placement == DcrPlacement::Middle ? half_dt : 2.0 * half_dt * (1.0 - pen.time);
+  const PairPoints X_c = X_new - tau * V;
   const PairPoints V_before = V;
-  out.impulse = dcr_impulse(kind, s, X_mid, V, inv_mass, law);
-  X_new += half_dt * (V - V_before);
-  // What is left is projected, to no more than half the separation the pair had at the start
-  // of the step (an elastic impulse at X_mid brings a pair back to it, so the projection
-  // takes up only what the impulse could not) and no less than twice the touching tolerance.
+  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law);
+  X_new += tau * (V - V_before);
+  // What is left is projected, to no less than twice the touching tolerance and, in the
+  // middle, to no more than half the separation the pair had at the start of the step (an
+  // elastic impulse at X_mid brings a pair back to it, so the projection takes up only what
+  // the impulse could not). At the contact time an elastic impulse leaves the pair apart by
+  // (1 - t*) / t* of that: only the touching tolerance is asked for.
   const double unit = pair_length_scale(kind, X_new) * pair_normal_norm(kind, X_new) / 6.0;
+  const double touch = 2.0 * dcr_touch_tolerance(kind, X_old, X_new);
   const double target =
-      std::max(2.0 * dcr_touch_tolerance(kind, X_old, X_new), std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)));
-  out.separated = s * pair_volume(X_new) >= target || dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit);
+      law.placement == DcrPlacement::Middle
+          ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
+          : touch;
+  out.separated = s * pair_volume(X_new) >= target ||
+                  dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit);
   return out;
 }
 

@@ -24,7 +24,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   options_.friction = spec.friction;
   options_.max_sweeps = spec.max_sweeps;
   margin_fraction_ = spec.search_margin;
-  options_.mid_step = spec.mid_step;
+  options_.placement = spec.placement;
   rebuild(model.mesh);
 }
 
