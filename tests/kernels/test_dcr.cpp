@@ -551,82 +551,53 @@ TEST(DcrResolvePair, FixedNodesNeverMove) {
   EXPECT_CLOSE(V(0, 0), 0.0, 0, 1e-15);                     // 0.1 slide stopped by 0.3 x 4.5
 }
 
-// The collision in the middle of the step: a vertex with a random velocity strikes a
-// triangle whose nodes translate together (g is linear in time up to the impulse, which
-// alone separates the pair: no projection). Momenta about the end-of-step configuration
-// and the kinetic energy are kept to round-off, the pair ends clear, and X_new - (dt/2) V
-// is the same mid-step configuration before and after.
-TEST(DcrResolvePair, MidStepImpulseKeepsMomentaAndPlacesTheCollisionAtHalfStep) {
-  std::mt19937_64 rng(43);
-  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 0.3);
-  const double dt = 1e-3, half = 0.5 * dt;
-  const DcrLaw law{1.0, 0.0, 1e-6, DcrPlacement::Middle};
-  int resolved = 0;
-  double worst_p = 0, worst_L = 0, worst_K = 0, worst_mid = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    const Vec3 face_v(u(rng), u(rng), u(rng));
-    const Vec3 p_old(pos(rng), pos(rng), 0.5 * pos(rng));  // above the face, inside it
-    const Vec3 p_v = face_v + Vec3(u(rng), u(rng), -(1.5 + 0.4 * u(rng)) * p_old.z() / dt);  // crosses in the step
-    PairPoints V = points(p_v, face_v, face_v, face_v);
-    const PairPoints X_old = points(p_old, kA, kB, kC);
-    PairPoints X = X_old + dt * V;
-    const PairWeights w = random_inv_mass(rng);
-    const Ledger before = ledger(X, V, w);  // free flight: the same about X_old and X
-    const PairPoints X_mid = X - half * V;
-    const DcrPairResponse r = dcr_resolve_pair(VF, X_old, X, V, kVertexDown, w, law, half);
-    if (!r.active) continue;
-    ++resolved;
-    ASSERT_TRUE(r.separated);
-    const Ledger after = ledger(X, V, w);
-    worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
-    worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
-    worst_K = std::max(worst_K, std::abs(after.kinetic - before.kinetic) / before.kinetic);
-    worst_mid = std::max(worst_mid, (X - half * V - X_mid).norm() / X_mid.norm());
+// The collision in the middle of the step and at the contact time t*: a vertex with a
+// random velocity strikes a triangle whose nodes translate together (g is linear in time up
+// to the impulse, which alone separates the pair: no projection). Momenta about the
+// end-of-step configuration and the kinetic energy are kept to round-off, the pair ends
+// clear, and the impulse configuration X_new - tau V (tau = dt/2, or (1 - t*) dt) is the
+// same before and after; at t* it is the contact configuration, g = 0.
+TEST(DcrResolvePair, ImpulseBetweenFreeFlightsKeepsMomentaMidStepAndAtContactTime) {
+  for (const DcrPlacement placement : {DcrPlacement::Middle, DcrPlacement::Impact}) {
+    SCOPED_TRACE(static_cast<int>(placement));
+    std::mt19937_64 rng(43);
+    std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 0.3);
+    const double dt = 1e-3, half = 0.5 * dt;
+    const DcrLaw law{1.0, 0.0, 1e-6, placement};
+    int resolved = 0;
+    double worst_p = 0, worst_L = 0, worst_K = 0, worst_c = 0, worst_g = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      const Vec3 face_v(u(rng), u(rng), u(rng));
+      const Vec3 p_old(pos(rng), pos(rng), 0.5 * pos(rng));  // above the face, inside it
+      const Vec3 p_v = face_v + Vec3(u(rng), u(rng), -(1.5 + 0.4 * u(rng)) * p_old.z() / dt);  // crosses in the step
+      PairPoints V = points(p_v, face_v, face_v, face_v);
+      const PairPoints X_old = points(p_old, kA, kB, kC);
+      PairPoints X = X_old + dt * V;
+      const PairWeights w = random_inv_mass(rng);
+      const Ledger before = ledger(X, V, w);  // free flight: the same about X_old and X
+      const double t_star = dcr_detect(VF, X_old, X, kVertexDown).time;
+      const double tau = placement == DcrPlacement::Middle ? half : (1 - t_star) * dt;
+      const PairPoints X_c = X - tau * V;
+      const DcrPairResponse r = dcr_resolve_pair(VF, X_old, X, V, kVertexDown, w, law, half);
+      if (!r.active) continue;
+      ++resolved;
+      ASSERT_TRUE(r.separated);
+      ASSERT_GT(-pair_volume(X), 0.0);
+      const Ledger after = ledger(X, V, w);
+      worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
+      worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
+      worst_K = std::max(worst_K, std::abs(after.kinetic - before.kinetic) / before.kinetic);
+      worst_c = std::max(worst_c, (X - tau * V - X_c).norm() / X_c.norm());
+      if (placement == DcrPlacement::Impact)
+        worst_g = std::max(worst_g, std::abs(pair_volume(X_c)) / std::abs(pair_volume(X_old)));
+    }
+    EXPECT_GT(resolved, 280);
+    EXPECT_LT(worst_p, 1e-13);
+    EXPECT_LT(worst_L, 1e-13);
+    EXPECT_LT(worst_K, 1e-13);
+    EXPECT_LT(worst_c, 1e-14);
+    EXPECT_LT(worst_g, 1e-12);
   }
-  EXPECT_GT(resolved, 280);
-  EXPECT_LT(worst_p, 1e-13);
-  EXPECT_LT(worst_L, 1e-13);
-  EXPECT_LT(worst_K, 1e-13);
-  EXPECT_LT(worst_mid, 1e-14);
-}
-
-// The collision at the contact time (contact.placement: impact): the same impacts; the
-// impulse acts at X_new - (1 - t*) dt V, which is the contact configuration (g = 0) and stays
-// so through the update; momenta and kinetic energy kept to round-off, the pair ends clear.
-TEST(DcrResolvePair, ImpactTimeImpulseKeepsMomentaAndActsAtTheContactConfiguration) {
-  std::mt19937_64 rng(44);
-  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 0.3);
-  const double dt = 1e-3, half = 0.5 * dt;
-  const DcrLaw law{1.0, 0.0, 1e-6, DcrPlacement::Impact};
-  int resolved = 0;
-  double worst_p = 0, worst_L = 0, worst_K = 0, worst_g = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    const Vec3 face_v(u(rng), u(rng), u(rng));
-    const Vec3 p_old(pos(rng), pos(rng), 0.5 * pos(rng));
-    const Vec3 p_v = face_v + Vec3(u(rng), u(rng), -(1.5 + 0.4 * u(rng)) * p_old.z() / dt);
-    PairPoints V = points(p_v, face_v, face_v, face_v);
-    const PairPoints X_old = points(p_old, kA, kB, kC);
-    PairPoints X = X_old + dt * V;
-    const PairWeights w = random_inv_mass(rng);
-    const Ledger before = ledger(X, V, w);
-    const double t_star = dcr_detect(VF, X_old, X, kVertexDown).time;
-    const DcrPairResponse r = dcr_resolve_pair(VF, X_old, X, V, kVertexDown, w, law, half);
-    if (!r.active) continue;
-    ++resolved;
-    ASSERT_TRUE(r.separated);
-    ASSERT_GT(-pair_volume(X), 0.0);
-    const Ledger after = ledger(X, V, w);
-    worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
-    worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
-    worst_K = std::max(worst_K, std::abs(after.kinetic - before.kinetic) / before.kinetic);
-    const PairPoints X_c = X - (1 - t_star) * dt * V;
-    worst_g = std::max(worst_g, std::abs(pair_volume(X_c)) / std::abs(pair_volume(X_old)));
-  }
-  EXPECT_GT(resolved, 280);
-  EXPECT_LT(worst_p, 1e-13);
-  EXPECT_LT(worst_L, 1e-13);
-  EXPECT_LT(worst_K, 1e-13);
-  EXPECT_LT(worst_g, 1e-12);
 }
 
 TEST(DcrResolvePair, RandomMultiPairImpactsConserveMomenta) {
