@@ -48,9 +48,20 @@ Coloring color_found(const ContactPairs& pairs, std::span<const Index> found, st
 
 }  // namespace
 
+PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, std::span<const Vec3> x) {
+  PairNormals N = PairNormals::Zero();
+  if (!surface.surface) return N;
+  const auto& n = pair.nodes;
+  const bool vf = pair.kind == ContactPair::VertexFace;
+  N.col(0) = surface_normal(*surface.surface, *surface.around, x, n[0], vf ? -1 : n[1]);
+  if (!vf) N.col(1) = surface_normal(*surface.surface, *surface.around, x, n[2], n[3]);
+  return N;
+}
+
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass, double dt,
-                           const DcrOptions& options, DcrScratch& scratch, const DcrGather& gather) {
+                           const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
+                           const DcrGather& gather) {
   const size_t n_nodes = x_new.size();
   SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
                   "resolve_contacts: nodal arrays differ in size (x_new "
@@ -66,7 +77,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
                                                                                             << " beyond the " << n_nodes
                                                                                             << " nodal values");
   }
-  const DcrLaw law{options.restitution, options.friction, options.gap, options.mid_step};
+  const DcrLaw law{options.restitution, options.friction, options.gap, options.placement};
   if (scratch.moved.size() < n_nodes) scratch.moved.resize(n_nodes, 0);
   if (scratch.slot.size() < n_nodes) scratch.slot.resize(n_nodes, -1);
 
@@ -100,7 +111,10 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
           hit[k] = 3;
           continue;
         }
-        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new).penetrating ? 2 : 1;
+        hit[k] = distinct_nodes(p) &&
+                         dcr_detect(dcr_kind(p), X_old, X_new, pair_normals(p, surface, x_old)).penetrating
+                     ? 2
+                     : 1;
       }
     });
     std::vector<Index> found;
@@ -134,7 +148,8 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
             V.col(i) = v[n];
             w[i] = inv_mass[n];
           }
-          const DcrPairResponse out = dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, w, law, 0.5 * dt);
+          const DcrPairResponse out =
+              dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, pair_normals(p, surface, x_old), w, law, 0.5 * dt);
           if (!out.active) continue;
           active[f] = 1;
           dissipated[f] = out.impulse.dissipated;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "contact/pairs.hpp"
+#include "contact/surface.hpp"
 #include "kernels/dcr.hpp"
 
 namespace shatter {
@@ -23,7 +24,7 @@ struct DcrOptions {
   double friction = 0.0;     ///< Coulomb mu >= 0
   double gap = 1e-6;         ///< separation after projection, fraction of the pair's longest edge
   int max_sweeps = 100;      ///< cap on the rounds; reaching it with pairs still found sets DcrResult::capped
-  bool mid_step = false;     ///< collision in the middle of the step (DcrLaw::mid_step)
+  DcrPlacement placement = DcrPlacement::End;  ///< where in the step a collision is placed (DcrLaw)
 };
 
 /// Summary of one call of resolve_contacts.
@@ -49,13 +50,25 @@ struct DcrScratch {
   std::vector<Index> overlapping;  ///< out: the pairs of mine whose swept boxes overlap (last call)
 };
 
+/// The surface whose outward normals at x_old orient the pairs (kernels/dcr.hpp
+/// dcr_orientation, surface_normal); without one (null) no pair has normals.
+struct DcrSurface {
+  const ContactSurface* surface = nullptr;
+  const VertexTriangles* around = nullptr;
+};
+
+/// The outward normals of a pair at x (surface_normal): a vertex-face pair's vertex normal
+/// (and 0), an edge-edge pair's normals of edge a and edge b; all 0 without a surface.
+PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, std::span<const Vec3> x);
+
 /// Resolves the penetrations of one step (DESIGN.md step 2). Nodal arrays are indexed by
 /// the node ids of the pairs:
 ///   x_new     positions at the end of the step (m), projected in place;
 ///   x_old     positions at the start of the step (m), the motion is linear in between;
 ///   v         velocities (m/s), changed in place by the impulses;
 ///   inv_mass  inverse lumped masses (1/kg), 0 for a fixed node (never moved);
-///   dt        the step length (s): x_new = x_old + dt v before contact.
+///   dt        the step length (s): x_new = x_old + dt v before contact;
+///   surface   the outward normals at x_old that orient the pairs (DcrSurface).
 /// pairs is the candidate list (the same on every rank) and mine the indices of the pairs
 /// this rank checks, ascending. The work goes in rounds:
 ///   1. detection, in parallel, reading only: in the first round each pair of mine whose swept
@@ -75,6 +88,7 @@ struct DcrScratch {
 /// tbb::task_arena to choose the thread count.
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass,
-                           double dt, const DcrOptions& options, DcrScratch& scratch, const DcrGather& gather = {});
+                           double dt, const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
+                           const DcrGather& gather = {});
 
 }  // namespace shatter

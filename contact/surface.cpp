@@ -131,4 +131,47 @@ void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> tri
   merge_unique(surface.vertices, vertices);
 }
 
+VertexTriangles vertex_triangles(const ContactSurface& surface) {
+  std::vector<std::pair<Index, Index>> incidence;  // (position in vertices, triangle)
+  incidence.reserve(3 * surface.triangles.size());
+  for (size_t t = 0; t < surface.triangles.size(); ++t)
+    for (const Index n : surface.triangles[t]) {
+      const auto it = std::lower_bound(surface.vertices.begin(), surface.vertices.end(), n);
+      incidence.emplace_back(static_cast<Index>(it - surface.vertices.begin()),
+                             static_cast<Index>(t));
+    }
+  std::sort(incidence.begin(), incidence.end());
+  VertexTriangles out;
+  out.offsets.assign(surface.vertices.size() + 1, 0);
+  out.items.reserve(incidence.size());
+  for (const auto& [k, t] : incidence) {
+    ++out.offsets[k + 1];
+    out.items.push_back(t);
+  }
+  for (size_t k = 0; k < surface.vertices.size(); ++k) out.offsets[k + 1] += out.offsets[k];
+  return out;
+}
+
+Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around,
+                    std::span<const Vec3> x, Index node, Index other) {
+  const auto it = std::lower_bound(surface.vertices.begin(), surface.vertices.end(), node);
+  SHATTER_REQUIRE(it != surface.vertices.end() && *it == node &&
+                      around.offsets.size() == surface.vertices.size() + 1,
+                  "surface_normal: node "
+                      << node << " is not a vertex of the surface, or the vertex -> triangle "
+                      << "CSR is not the surface's");
+  const auto k = static_cast<size_t>(it - surface.vertices.begin());
+  Vec3 n = Vec3::Zero();
+  double sum = 0;  // of the triangles' |normal|: what the two sides of a sheet cancel to round-off
+  for (Index j = around.offsets[k]; j < around.offsets[k + 1]; ++j) {
+    const auto& t = surface.triangles[around.items[j]];
+    if (other < 0 || t[0] == other || t[1] == other || t[2] == other) {
+      const Vec3 nt = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+      n += nt;
+      sum += nt.norm();
+    }
+  }
+  return n.norm() > 1e-9 * sum ? n : Vec3::Zero();
+}
+
 }  // namespace shatter

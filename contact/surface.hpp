@@ -64,4 +64,22 @@ void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> tri
 /// A surface made of the given triangles, in the given order.
 ContactSurface make_contact_surface(std::span<const SurfaceTriangle> triangles);
 
+/// The triangles around each surface vertex, CSR over the positions in surface.vertices:
+/// the triangles of vertices[k] are items[offsets[k] .. offsets[k + 1]), ascending.
+struct VertexTriangles {
+  std::vector<Index> offsets, items;
+};
+
+/// The vertex -> triangle CSR of a surface, O(t log t).
+VertexTriangles vertex_triangles(const ContactSurface& surface);
+
+/// Outward surface normal at a surface vertex `node` (m^2, not normalised): the sum of
+/// (x1 - x0) x (x2 - x0) over the triangles {x0, x1, x2} around it (twice the area-weighted
+/// mean of their unit normals), or, with `other` >= 0, over those that also hold `other`:
+/// the normal of the edge node-other (its one or two triangles). Where the two sides of a
+/// sheet meet they cancel: 0 when |sum| <= 1e-9 sum of |terms|. x: positions indexed by mesh node.
+/// DCR orients its pairs by them (kernels/dcr.hpp dcr_orientation).
+Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around,
+                    std::span<const Vec3> x, Index node, Index other = -1);
+
 }  // namespace shatter

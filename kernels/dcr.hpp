@@ -11,7 +11,8 @@
 //   V(x) = (x1 - x0) . ((x2 - x0) x (x3 - x0)) / 6                      [m^3]
 // and the orientation s chosen so that g > 0 is admissible: for a vertex and
 // a face s = -1, i.e. g = ((b - a) x (c - a)) . (p - a) / 6 > 0 when p is on
-// the outer side; for two edges s is the sign of V at the start of the step.
+// the outer side; for two edges s keeps edge b on the outer side of edge a, from
+// the outward surface normals at their nodes (dcr_orientation).
 // g is invariant under translations and rotations of the four points, so
 // sum_i grad_i g = 0 and sum_i x_i x grad_i g = 0: impulses along grad g (and
 // along the gradient of any such function) conserve linear and angular
@@ -27,13 +28,14 @@
 //   3. momentum decomposition (dcr_impulse), [CW] sec. 3-4: normal part
 //      v_n = grad g . v / (grad g . W grad g), v' = v - (1 + e) v_n W grad g,
 //      then Coulomb friction as a second decomposition along a slide direction;
-//   dcr_resolve_pair places the collision at the end of the step (2 then 3, [CW])
-//   or in the middle (3 at the mid-step configuration, 2 only for what is left).
+//   dcr_resolve_pair places the collision at the end of the step (2 then 3, [CW]),
+//   in the middle or at the contact time t* (3 there, 2 only for what is left).
 // Pure functions: no allocation, no threads, no I/O.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "kernels/types.hpp"
 
@@ -41,10 +43,20 @@ namespace shatter {
 
 /// The four points (columns, m) or velocities (m/s) of one contact pair.
 using PairPoints = Eigen::Matrix<double, 3, 4>;
+/// The outward surface normals of one pair at the start of the step (columns, any length,
+/// 0 = none): VertexFace: the vertex's (column 1 unused); EdgeEdge: edge a's and edge b's.
+using PairNormals = Eigen::Matrix<double, 3, 2>;
 /// One value per node of a pair, e.g. the inverse lumped masses (1/kg; 0 = fixed node).
 using PairWeights = Eigen::Vector4d;
 
 enum class DcrPairKind : std::uint8_t { VertexFace = 0, EdgeEdge = 1 };
+
+/// Where in the step dcr_resolve_pair places a collision (scene key contact.placement).
+enum class DcrPlacement : std::uint8_t {
+  End = 0,     ///< projection, then the impulse at the end of the step ([CW])
+  Middle = 1,  ///< the impulse at the mid-step configuration
+  Impact = 2,  ///< the impulse at the configuration of the contact time t*
+};
 
 /// Contact law of the DCR response.
 struct DcrLaw {
@@ -52,8 +64,7 @@ struct DcrLaw {
   double friction = 0.0;     ///< Coulomb coefficient mu >= 0
   double gap = 1e-6;         ///< separation left after projection, as a fraction of the
                              ///< pair's longest edge (dimensionless)
-  bool mid_step = false;     ///< collision placement: false = end of the step, true = middle
-                             ///< (dcr_resolve_pair)
+  DcrPlacement placement = DcrPlacement::End;  ///< dcr_resolve_pair
 };
 
 /// A distance below kDcrTouchTolerance L (L the pair's longest edge) counts as touching:
@@ -106,14 +117,45 @@ inline double dcr_touch_tolerance(DcrPairKind kind, const PairPoints& X_old, con
          std::max(pair_normal_norm(kind, X_old), pair_normal_norm(kind, X_new)) / 6.0;
 }
 
-/// Orientation s of the constraint g = s V: -1 for a vertex and a face; for two
-/// edges the sign of V at the start of the step, or, when they start touching,
-/// the side they came from: -sign(V(X_new)) (so moving through counts as penetration).
-inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
+/// Cosine below which two directions count as facing each other (dcr_orientation,
+/// dcr_detect): a cone of about 78 degrees, wide enough for the normal cone of a cube's
+/// corner (whose averaged normal makes at most 55 degrees with any direction in it).
+inline constexpr double kDcrFacingTolerance = 0.2;
+
+/// Orientation s of the constraint g = s V (g > 0 admissible), or 0 when it cannot be told
+/// (the pair is then never a penetration). N: the pair's outward normals at X_old
+/// (PairNormals; 0 = none, as where the two sides of a sheet cancel).
+///  - VertexFace: s = -1.
+///  - EdgeEdge: the edges' outward normals n_a = N_0, n_b = N_1 against the
+///    normal c = e_a x e_b of the plane through edge a parallel to edge b. Edges can touch from
+///    outside only where that plane supports both bodies, c in the normal cone of one and -c
+///    in that of the other: n_a . c >= kDcrFacingTolerance |n_a| |c| and
+///    n_b . c <= -kDcrFacingTolerance |n_b| |c| (edge b on the +c side of edge a), or the
+///    reverse. Moving edge b by d changes V by -d . c / 6, so s = -1 when b belongs on the
+///    +c side, +1 on the -c side; a missing normal leaves its condition out. When neither
+///    holds the plane cuts through a body and the pair is no constraint (s = 0; an edge
+///    sliding across it then has its end points and other edges caught by other pairs).
+///    Without any normal: the sign of V(X_old), the side the edges start on (0 when they
+///    start touching, |V| <= tol).
+/// With normals the orientation is a property of the bodies, not of the motion: a pair
+/// that starts on the wrong side (left there by an earlier step) is not pulled through
+/// again, and touching edges that move apart are not a penetration.
+inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const PairNormals& N,
+                              double tol) {
   if (kind == DcrPairKind::VertexFace) return -1.0;
+  const Vec3 c = (X_old.col(1) - X_old.col(0)).cross(X_old.col(3) - X_old.col(2));
+  const Vec3 n_a = N.col(0), n_b = N.col(1);
+  const double la = n_a.norm(), lb = n_b.norm();
+  if (la > 0 || lb > 0) {
+    if (!(c.norm() > 0)) return 0.0;
+    const double fa = n_a.dot(c), fb = n_b.dot(c), k = kDcrFacingTolerance * c.norm();
+    if ((la == 0 || fa >= k * la) && (lb == 0 || fb <= -k * lb)) return -1.0;
+    if ((la == 0 || fa <= -k * la) && (lb == 0 || fb >= k * lb)) return 1.0;
+    return 0.0;
+  }
   const double V0 = pair_volume(X_old);
-  if (std::abs(V0) > dcr_touch_tolerance(kind, X_old, X_new)) return V0 > 0 ? 1.0 : -1.0;
-  return pair_volume(X_new) > 0 ? -1.0 : 1.0;
+  if (std::abs(V0) <= tol) return 0.0;
+  return V0 > 0 ? 1.0 : -1.0;
 }
 
 /// A cubic c0 + c1 t + c2 t^2 + c3 t^3.
@@ -177,34 +219,63 @@ struct DcrPenetration {
   double orientation = 1.0;  ///< s of g = s V (set when penetrating)
 };
 
+/// How far inside its primitives the pair's closest point lies at X: for a vertex and a
+/// face the smallest barycentric coordinate of the vertex's projection on the face's plane;
+/// for two edges the smallest of sa, 1 - sa, sb, 1 - sb (the line parameters of the two
+/// closest points). -infinity for a degenerate triangle or parallel edges (left to the
+/// neighbouring pairs). Dimensionless: >= 0 inside, 0 on the boundary.
+inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
+  constexpr double kOutside = -std::numeric_limits<double>::infinity();
+  if (kind == DcrPairKind::VertexFace) {
+    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), w = X.col(0) - X.col(1);
+    const Vec3 nrm = e1.cross(e2);
+    const double nn = nrm.squaredNorm();
+    if (!(nn > kDcrParallelTolerance * e1.squaredNorm() * e2.squaredNorm())) return kOutside;
+    const double lb = w.cross(e2).dot(nrm) / nn, lc = e1.cross(w).dot(nrm) / nn;
+    return std::min({1.0 - lb - lc, lb, lc});
+  }
+  const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), w = X.col(0) - X.col(2);
+  const double aa = ea.dot(ea), ab = ea.dot(eb), bb = eb.dot(eb), aw = ea.dot(w), bw = eb.dot(w);
+  const double den = aa * bb - ab * ab;
+  if (!(den > kDcrParallelTolerance * aa * bb)) return kOutside;
+  const double sa = (ab * bw - bb * aw) / den, sb = (aa * bw - ab * aw) / den;
+  return std::min({sa, 1.0 - sa, sb, 1.0 - sb});
+}
+
 /// Whether the pair penetrated during the step, positions moving linearly from X_old
-/// (t = 0) to X_new (t = 1). Penetration: g(X_new) < -tol, and at the time t* where the
-/// final stretch of negative g begins (g(t*) = 0, found on the monotone pieces of the
-/// cubic g(t), or t* = 0 when the pair starts touching, |g| <= tol) the vertex lies in
-/// the triangle (barycentric coordinates >= -kDcrInsideTolerance) / the two segments
-/// cross (both line parameters in [-tol, 1 + tol], the edges not parallel).
+/// (t = 0) to X_new (t = 1); N: the pair's outward normals at X_old (dcr_orientation).
+/// Penetration: g(X_new) < -tol, and at the time t* where the final stretch of negative g
+/// begins (g(t*) = 0, found on the monotone pieces of the cubic g(t), or t* = 0 when the
+/// pair starts touching, |g| <= tol) the vertex lies in the triangle / the two segments
+/// cross: dcr_inside_margin >= -kDcrInsideTolerance (so that a vertex crossing exactly on
+/// an edge shared by two triangles is caught by both).
+/// A crossing on the boundary (margin within kDcrInsideTolerance of 0), and a pair that
+/// starts touching, which has no crossing point of its own (its inside test is made where
+/// the motion takes it, at X_new), may be a graze rather than a contact, and count only
+///  - for a vertex, when it faces the triangle: its outward normal against the triangle's,
+///    cosine <= -kDcrFacingTolerance (a vertex of one body's face, sliding in the plane of
+///    another body's bottom face, meets that body's side face exactly on its edge);
+///  - for two edges, when they still cross at X_new (an edge's end point sliding over
+///    another edge in the plane of its face crosses it only at that instant).
 /// Robust for fast motion (exact cubic in t, no sampling), grazing (g touches 0 and
-/// returns: g(X_new) > -tol), touching at the end (|g| <= tol) and degenerate
-/// geometry (zero-area triangles and parallel edges are left to neighbouring pairs).
+/// returns: g(X_new) > -tol), touching at the end (|g| <= tol), touching at the start
+/// (coincident faces) and degenerate geometry.
 /// tol = dcr_touch_tolerance(kind, X_old, X_new).
-inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
+inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                 const PairNormals& N) {
   DcrPenetration out;
-  // Exact exits before the tolerance (two square roots), for most candidates: s V(X_new) < -tol
-  // needs V(X_new) > 0 for a vertex and a face (s = -1); for two edges whose volume keeps its
-  // sign (s = its sign unless |V(X_old)| <= tol) it needs |V(X_old)| <= tol < |V(X_new)|.
+  // An exact exit before the tolerance (two square roots), for most vertex-face candidates:
+  // s V(X_new) < -tol needs V(X_new) > 0 (s = -1).
   const double V_new = pair_volume(X_new);
   if (kind == DcrPairKind::VertexFace && !(V_new > 0.0)) return out;
-  if (kind == DcrPairKind::EdgeEdge) {
-    const double V_old = pair_volume(X_old);
-    if (V_old * V_new > 0.0 && std::abs(V_new) <= std::abs(V_old)) return out;
-  }
-  out.orientation = dcr_orientation(kind, X_old, X_new);
-  const double s = out.orientation;
   const double tol = dcr_touch_tolerance(kind, X_old, X_new);
-  if (!(s * pair_volume(X_new) < -tol)) return out;
+  out.orientation = dcr_orientation(kind, X_old, N, tol);
+  const double s = out.orientation;
+  if (!(s * V_new < -tol)) return out;  // also s = 0
 
   DcrCubic g = pair_volume_along(X_old, X_new - X_old);
   g = {s * g.c0, s * g.c1, s * g.c2, s * g.c3};
+  const bool touching = std::abs(g.c0) <= tol;
   std::array<double, 4> br;
   const int n = dcr_monotone_breaks(g, 0.0, 1.0, br);
   double t_star = -1.0;
@@ -218,23 +289,16 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   }
   if (t_star < 0.0) return out;  // behind the face / the other edge all step long
 
-  const PairPoints X = X_old + t_star * (X_new - X_old);
-  if (kind == DcrPairKind::VertexFace) {
-    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), w = X.col(0) - X.col(1);
-    const Vec3 nrm = e1.cross(e2);
-    const double nn = nrm.squaredNorm();
-    if (!(nn > kDcrParallelTolerance * e1.squaredNorm() * e2.squaredNorm())) return out;
-    const double lb = w.cross(e2).dot(nrm) / nn, lc = e1.cross(w).dot(nrm) / nn;
-    const double la = 1.0 - lb - lc;
-    if (la < -kDcrInsideTolerance || lb < -kDcrInsideTolerance || lc < -kDcrInsideTolerance) return out;
-  } else {
-    const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), w = X.col(0) - X.col(2);
-    const double aa = ea.dot(ea), ab = ea.dot(eb), bb = eb.dot(eb), aw = ea.dot(w), bw = eb.dot(w);
-    const double den = aa * bb - ab * ab;
-    if (!(den > kDcrParallelTolerance * aa * bb)) return out;
-    const double sa = (ab * bw - bb * aw) / den, sb = (aa * bw - ab * aw) / den;
-    const double lo = -kDcrInsideTolerance, hi = 1.0 + kDcrInsideTolerance;
-    if (sa < lo || sa > hi || sb < lo || sb > hi) return out;
+  const double margin =
+      dcr_inside_margin(kind, touching ? X_new : PairPoints(X_old + t_star * (X_new - X_old)));
+  if (!(margin >= -kDcrInsideTolerance)) return out;
+  if (touching || margin <= kDcrInsideTolerance) {
+    if (kind == DcrPairKind::VertexFace) {
+      const Vec3 n_face = (X_old.col(2) - X_old.col(1)).cross(X_old.col(3) - X_old.col(1));
+      if (N.col(0).dot(n_face) > -kDcrFacingTolerance * N.col(0).norm() * n_face.norm()) return out;
+    } else if (!(dcr_inside_margin(kind, X_new) >= -kDcrInsideTolerance)) {
+      return out;
+    }
   }
   out.penetrating = true;
   out.time = t_star;
@@ -388,48 +452,60 @@ struct DcrPairResponse {
 
 /// One DCR resolution of a pair over a step of the central-difference predictor
 /// X_new = X_old + dt V (V the mid-step velocity, half_dt = dt / 2): detect (dcr_detect on
-/// X_old -> X_new); if the pair penetrates, resolve it with the collision placed
-///  - at the end of the step (law.mid_step false, [CW]'s impact time approximation):
-///    project X_new (dcr_project, direction from the configuration at t*), then the impulse
-///    at the projected positions (dcr_impulse);
-///  - in the middle of the step (law.mid_step true): a free flight to X_mid = X_new - half_dt V,
-///    the impulse there, a free flight on: V' = V + dV (dcr_impulse at X_mid),
-///    X_new += half_dt dV; then dcr_project only if the pair is still closer than the gap.
-/// Why the middle: a velocity change dv at the mid step that moves x(n+1) by dx changes the
-/// central-difference total energy by about f(n+1) . (half_dt dv - dx) besides the impulse's
-/// own kinetic-energy balance, which dx = half_dt dv cancels (the end placement has
-/// dx ~ (1 - t*) half_dt dv and loses t* half_dt f . dv per impact); and an impulse that is a
-/// gradient of rotation-invariant functions at X_mid between two free flights keeps
-/// sum m v and sum x x m v exactly. X_mid = X_new - half_dt V is kept by the update, so
-/// repeated resolutions of the pair in a step act at the same configuration. The final
-/// projection (at fixed velocities) is the exception that moves angular momentum and energy:
-/// it is needed when the impulse alone does not separate the pair (e < 1, pairs coupled
-/// through shared nodes, strongly curved g(t)). X_new and V are updated in place.
-inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new,
-                                        PairPoints& V, const PairWeights& inv_mass, const DcrLaw& law,
+/// X_old -> X_new, N the pair's outward normals); if the pair penetrates, resolve it with the
+/// collision placed (law.placement)
+///  - End: at the end of the step ([CW]'s impact time approximation): project X_new
+///    (dcr_project, direction from the configuration at t*), then the impulse at the projected
+///    positions (dcr_impulse);
+///  - Middle / Impact: at a time tau before the end of the step, tau = half_dt (Middle) or
+///    (1 - t*) dt (Impact, the contact time): a free flight back to X_c = X_new - tau V, the
+///    impulse there, a free flight on: V' = V + dV (dcr_impulse at X_c), X_new += tau dV;
+///    then dcr_project only if the pair is still closer than the gap.
+/// A velocity change dv at the mid step that moves x(n+1) by dx changes the central-difference
+/// total energy by about f(n+1) . (half_dt dv - dx) besides the impulse's own kinetic-energy
+/// balance: End has dx ~ (1 - t*) half_dt dv and loses t* half_dt f . dv per impact, Middle
+/// has dx = half_dt dv (no first-order term), Impact dx = (1 - t*) dt dv (a term
+/// (t* - 1/2) dt f . dv, of either sign). An impulse that is a gradient of rotation-invariant
+/// functions at X_c between two free flights keeps sum m v and sum x x m v exactly, whatever
+/// tau. X_c = X_new - tau V is kept by the update, so repeated resolutions of the pair in a
+/// step with the same tau act at the same configuration. The final projection (at fixed
+/// velocities) is the exception that moves angular momentum and energy: it is needed when the
+/// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
+/// strongly curved g(t)). X_new and V are updated in place.
+inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old,
+                                        PairPoints& X_new, PairPoints& V, const PairNormals& N,
+                                        const PairWeights& inv_mass, const DcrLaw& law,
                                         double half_dt) {
   DcrPairResponse out;
-  const DcrPenetration pen = dcr_detect(kind, X_old, X_new);
+  const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N);
   if (!pen.penetrating) return out;
   out.active = true;
   const double s = pen.orientation;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
-  if (!law.mid_step) {
+  if (law.placement == DcrPlacement::End) {
     out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap);
     out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
     return out;
   }
-  const PairPoints X_mid = X_new - half_dt * V;
+  const double tau =
+      law.placement == DcrPlacement::Middle ? half_dt : 2.0 * half_dt * (1.0 - pen.time);
+  const PairPoints X_c = X_new - tau * V;
   const PairPoints V_before = V;
-  out.impulse = dcr_impulse(kind, s, X_mid, V, inv_mass, law);
-  X_new += half_dt * (V - V_before);
-  // What is left is projected, to no more than half the separation the pair had at the start
-  // of the step (an elastic impulse at X_mid brings a pair back to it, so the projection
-  // takes up only what the impulse could not) and no less than twice the touching tolerance.
+  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law);
+  X_new += tau * (V - V_before);
+  // What is left is projected, to no less than twice the touching tolerance and, in the
+  // middle, to no more than half the separation the pair had at the start of the step (an
+  // elastic impulse at X_mid brings a pair back to it, so the projection takes up only what
+  // the impulse could not). At the contact time an elastic impulse leaves the pair apart by
+  // (1 - t*) / t* of that: only the touching tolerance is asked for.
   const double unit = pair_length_scale(kind, X_new) * pair_normal_norm(kind, X_new) / 6.0;
+  const double touch = 2.0 * dcr_touch_tolerance(kind, X_old, X_new);
   const double target =
-      std::max(2.0 * dcr_touch_tolerance(kind, X_old, X_new), std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)));
-  out.separated = s * pair_volume(X_new) >= target || dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit);
+      law.placement == DcrPlacement::Middle
+          ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
+          : touch;
+  out.separated = s * pair_volume(X_new) >= target ||
+                  dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit);
   return out;
 }
 

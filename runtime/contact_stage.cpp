@@ -23,12 +23,13 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   options_.friction = spec.friction;
   options_.max_sweeps = spec.max_sweeps;
   margin_fraction_ = spec.search_margin;
-  options_.mid_step = spec.mid_step;
+  options_.placement = spec.placement;
   rebuild(model.mesh);
 }
 
 void ContactStage::rebuild(const Mesh& mesh) {
   surface_ = build_contact_surface(mesh);
+  vertex_triangles_ = vertex_triangles(surface_);
   std::vector<double> lengths;
   lengths.reserve(surface_.edges.size());
   for (const auto& [a, b] : surface_.edges) lengths.push_back((mesh.reference[a] - mesh.reference[b]).norm());
@@ -178,7 +179,8 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
       std::sort(found.begin(), found.end());
       profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
     };
-  const DcrResult r = resolve_contacts(pairs_, mine_, x_new, x_old, v, inv_mass, dt, options_, scratch_, gather);
+  const DcrResult r = resolve_contacts(pairs_, mine_, x_new, x_old, v, inv_mass, dt, options_,
+                                       {&surface_, &vertex_triangles_}, scratch_, gather);
   lap(profile_.sweep_seconds);
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());

@@ -96,6 +96,7 @@ class ContactStage {
   void assign_pairs(std::span<const Vec3> x);
 
   ContactSurface surface_;
+  VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;

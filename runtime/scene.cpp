@@ -378,8 +378,11 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
       }
       if (c["placement"]) {
         const std::string p = r.string(c["placement"], "contact.placement");
-        if (p != "end" && p != "middle") r.fail("contact.placement", "one of end, middle", c["placement"]);
-        cs.mid_step = p == "middle";
+        if (p != "end" && p != "middle" && p != "impact")
+          r.fail("contact.placement", "one of end, middle, impact", c["placement"]);
+        cs.placement = p == "end"      ? DcrPlacement::End
+                       : p == "middle" ? DcrPlacement::Middle
+                                       : DcrPlacement::Impact;
       }
     }
     s.contact = cs;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/dcr.hpp"
 #include "kernels/types.hpp"
 #include "mesh/gmsh_input.hpp"
 
@@ -51,7 +52,7 @@ struct ContactSpec {
   double restitution = 1.0;  ///< e in [0, 1]
   int max_sweeps = 100;       ///< cap on DCR Gauss-Seidel sweeps per step (contact.max_sweeps)
   double search_margin = 0.1; ///< candidate reuse margin, fraction of the median surface edge (contact.search_margin)
-  bool mid_step = false;     ///< contact.placement: false = end (of the step), true = middle
+  DcrPlacement placement = DcrPlacement::End;  ///< contact.placement: end, middle or impact
   bool sweep_cap_fatal = false;  ///< contact.on_sweep_cap: fail (the run stops, exit 1) instead of warn
 };
 

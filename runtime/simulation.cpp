@@ -109,7 +109,11 @@ Simulation::Simulation(Model& model, RunOptions options)
   a_.assign(n, Vec3::Zero());
   f_int_.assign(n, Vec3::Zero());
   f_ext_.assign(n, Vec3::Zero());
-  if (model_.scene.contact) contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
+  if (model_.scene.contact) {
+    contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
+    book_contact_work_ =
+        model_.scene.contact->restitution < 1.0 || model_.scene.contact->friction > 0.0;
+  }
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
   if (model_.scene.fracture_enabled()) {
@@ -230,7 +234,19 @@ void Simulation::step() {
       const std::span<Vec3> arrays[] = {x_prev_, x_, v_};
       timed(comm_seconds_, [&] { dec_->share(*surface_nodes_, arrays); });
     }
+    const std::vector<Index>& vertices = contact_->surface().vertices;
+    if (book_contact_work_) {
+      contact_dx_.resize(vertices.size());
+      contact_dv_.resize(vertices.size());
+      for (size_t k = 0; k < vertices.size(); ++k)
+        contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
+    }
     const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt);
+    if (book_contact_work_)
+      for (size_t k = 0; k < vertices.size(); ++k) {
+        contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
+        contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
+      }
     ledger_.contacts = r.contacts;
     ledger_.contact_dissipated += r.dissipated;
     if (r.capped) {
@@ -254,9 +270,23 @@ void Simulation::step() {
         w += model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
     granule_sums_[gr * kGranuleSums + 8] = w;
     granule_sums_[gr * kGranuleSums + 9] = 0;
+    granule_sums_[gr * kGranuleSums + 10] = 0;
   }
 
   compute_forces(step_ + 1, time_ + dt, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
+  if (book_contact_work_) {
+    // What the contact's changes dx of x(n+1) and dv of v(n+1/2) did to the central-difference
+    // energy besides the impulses' kinetic-energy loss, to first order: -f(n+1) . (dx - dt/2 dv)
+    // (docs/contact.md, "The ledger with e < 1"); booked as contact dissipation.
+    const std::vector<Index>& vertices = contact_->surface().vertices;
+    for (size_t k = 0; k < vertices.size(); ++k) {
+      const Index i = vertices[k], gr = dec_->home_granule(i);
+      if (dec_->owns_granule(gr) &&
+          (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero()))
+        granule_sums_[gr * kGranuleSums + 10] +=
+            (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
+    }
+  }
 
   dec_->for_touched(n, half_kick);
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
@@ -460,12 +490,15 @@ void Simulation::update_ledger() {
   double t[kGranuleSums] = {};
   for (Index gr = 0; gr < dec_->num_granules(); ++gr)
     for (int f = 0; f < kGranuleSums; ++f) t[f] += all[gr * kGranuleSums + f];
-  for (Index gr : owned) granule_sums_[gr * kGranuleSums + 8] = granule_sums_[gr * kGranuleSums + 9] = 0;
+  for (Index gr : owned)
+    granule_sums_[gr * kGranuleSums + 8] = granule_sums_[gr * kGranuleSums + 9] =
+        granule_sums_[gr * kGranuleSums + 10] = 0;
   ledger_.kinetic = t[0];
   ledger_.momentum = Vec3(t[1], t[2], t[3]);
   ledger_.angular_momentum = Vec3(t[4], t[5], t[6]);
   ledger_.strain = t[7];
   ledger_.external_work += t[8] + t[9];
+  ledger_.contact_dissipated += t[10];
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
                                               std::abs(ledger_.external_work));

@@ -131,8 +131,9 @@ class Simulation {
   double next_dt() const;
 
   /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
-  /// strain, the step's gravity work, the step's reaction work.
-  static constexpr int kGranuleSums = 10;
+  /// strain, the step's gravity work, the step's reaction work, the step's contact work
+  /// f(n+1) . (dx - dt/2 dv) (book_contact_work_).
+  static constexpr int kGranuleSums = 11;
 
   Model& model_;
   RunOptions opt_;
@@ -158,6 +159,12 @@ class Simulation {
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
   std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
+  /// With a dissipative contact law (e < 1 or mu > 0) the first-order energy change of the
+  /// contact's moves is booked in contact_dissipated with the impulses' kinetic-energy loss
+  /// (docs/contact.md "The ledger with e < 1"); for e = 1, mu = 0 it is left visible.
+  bool book_contact_work_ = false;
+  std::vector<Vec3> contact_dx_,
+      contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block
   std::vector<double> stress6_;             ///< per element Cauchy stress for the facet check (fracture only)
   std::unique_ptr<FieldWriter> fields_;

@@ -35,6 +35,8 @@ struct Stack {
   std::vector<double> inv_mass;
   std::vector<std::pair<Sheet, Sheet>> contacts;  // (lower top sheet, upper bottom sheet)
   ContactPairs pairs;
+  std::vector<SurfaceTriangle>
+      triangles;  // every sheet's, for the outward normals (none: no normals)
 };
 
 Sheet make_sheet(Stack& s, int n, Vec3 origin, bool outside_up, const Vec3& velocity, double inv_mass_scale,
@@ -59,6 +61,8 @@ Sheet make_sheet(Stack& s, int n, Vec3 origin, bool outside_up, const Vec3& velo
       if (!outside_up) std::swap(t0[1], t0[2]), std::swap(t1[1], t1[2]);
       sheet.triangles.push_back(t0);
       sheet.triangles.push_back(t1);
+      s.triangles.push_back({t0, 0});
+      s.triangles.push_back({t1, 0});
     }
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
@@ -127,6 +131,8 @@ Stack make_stack(int bodies, int n, bool fixed_ground, std::uint64_t seed, bool 
     const Vec3 shift(0.37 * k - std::floor(0.37 * k), 0.23 * k - std::floor(0.23 * k), 0);
     if (thin) {
       const Sheet sheet = make_sheet(s, n, Vec3(0, 0, 0.2 * k) + shift, true, velocity, 1.0, rng);
+      for (const auto& t : flipped(sheet).triangles)
+        s.triangles.push_back({t, 0});  // its underside
       add_candidates(s, below, flipped(sheet));
       s.contacts.emplace_back(below, sheet);
       below = sheet;
@@ -201,9 +207,24 @@ std::vector<Index> every_pair(const Stack& s) {
   return all;
 }
 
+/// The stack's sheets as a contact surface, for the outward normals: on a thin sheet both
+/// sides cancel (none); a stack without triangles gives none at all.
+struct StackSurface {
+  ContactSurface surface;
+  VertexTriangles around;
+  explicit StackSurface(const Stack& s) {
+    if (s.triangles.empty()) return;
+    surface = make_contact_surface(s.triangles);
+    around = vertex_triangles(surface);
+  }
+  DcrSurface dcr() const { return surface.triangles.empty() ? DcrSurface{} : DcrSurface{&surface, &around}; }
+};
+
 DcrResult run(Stack& s, const DcrOptions& options, std::span<const Index> mine, const DcrGather& gather = {}) {
   DcrScratch scratch;
-  return resolve_contacts(s.pairs, mine, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, scratch, gather);
+  const StackSurface surface(s);
+  return resolve_contacts(s.pairs, mine, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, surface.dcr(), scratch,
+                          gather);
 }
 
 DcrResult run(Stack& s, const DcrOptions& options) { return run(s, options, every_pair(s)); }
@@ -266,6 +287,7 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
   std::vector<Index> even, odd;
   for (Index i = 0; i < static_cast<Index>(split.pairs.size()); ++i) (i % 2 ? odd : even).push_back(i);
   int gathers = 0;
+  const StackSurface other(split);
   const DcrResult r2 = run(split, options, even, [&](std::vector<Index>& found) {
     ++gathers;
     for (const Index i : odd) {
@@ -276,7 +298,9 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
         X_new.col(k) = split.x_new[p.nodes[k]];
       }
       const auto kind = p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
-      if (pair_boxes_overlap(p.kind, X_old, X_new) && dcr_detect(kind, X_old, X_new).penetrating) found.push_back(i);
+      if (pair_boxes_overlap(p.kind, X_old, X_new) &&
+          dcr_detect(kind, X_old, X_new, pair_normals(p, other.dcr(), split.x_old)).penetrating)
+        found.push_back(i);
     }
     std::sort(found.begin(), found.end());
   });
@@ -382,7 +406,7 @@ TEST(DcrSweep, RejectsInconsistentInput) {
   const std::vector<Index> all = every_pair(s);
   DcrScratch scratch;
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
-  EXPECT_THROW(resolve_contacts(s.pairs, all, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, scratch), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, all, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {}, scratch), Error);
   const std::vector<Index> beyond{static_cast<Index>(s.pairs.size())};
-  EXPECT_THROW(resolve_contacts(s.pairs, beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, scratch), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {}, scratch), Error);
 }

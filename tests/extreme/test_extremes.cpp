@@ -325,36 +325,44 @@ TEST(Extreme, StepAboveStableLimitStopsWithDiagnosis) {
 }
 
 // Two cubes whose faces coincide at t = 0 (z = 0 exactly), the upper one moving
-// down at 1 m/s: contact from the first step on, no penetration, and after it the
-// lower cube moves down faster than the upper one.
-// DEFECT (measured at this commit; run with --gtest_also_run_disabled_tests): the DCR
-// sweeps reach their cap in the first step, 1075 vertex-in-tet penetrations are left
-// over the run, the upper cube goes on down through the lower one (vz -0.62 against
-// -0.38) and the ledger gains 2.9 %. With the faces' node grids aligned instead of
-// offset: 13 capped steps, -10.8 %; with a gap of 1e-7 m: no capped step, -5.7 %.
-// Coplanar edge-edge pairs that start touching take their orientation from the end
-// of the step (kernels/dcr.hpp dcr_orientation), so half of them are pushed the
-// wrong way.
-TEST(Extreme, DISABLED_BodiesTouchingAtStart) {
-  Model m = build_model(scene_from_text(
-      "touching", two_body_scene("touching", kSoft,
-                                 "{name: lower, material: soft, mesh: {shape: box, size: [0.02, "
-                                 "0.02, 0.02], center: [0, 0, -0.01], "
-                                 "element_size: 0.01}}",
-                                 "{name: upper, material: soft, mesh: {shape: box, size: [0.02, "
-                                 "0.02, 0.02], center: [0.005, 0, 0.01], "
-                                 "element_size: 0.01}, initial_velocity: [0, 0, -1]}")));
-  Simulation sim(m, {});
-  sim.step();
-  EXPECT_GT(sim.ledger().contacts, 0) << "no contact in the first step";
-  const Watch w = run_watched(sim, 2e-3);
-  std::printf(
-      "touching: %ld steps, contact steps %ld, energy error max %.3e final %+.3e, vz %.3f %.3f\n",
-      w.steps, w.contact_steps, w.max_energy_error, sim.energy_error(), body_velocity(sim, 0).z(),
-      body_velocity(sim, 1).z());
-  expect_clean(w, 0.03);
-  EXPECT_LT(body_velocity(sim, 0).z(), body_velocity(sim, 1).z());
-  EXPECT_GT(body_centre(sim, 1).z() - body_centre(sim, 0).z(), 0.02 * (1 - 1e-3));
+// down at 1 m/s: contact from the first step on, no penetration, no capped step, and
+// after it the lower cube moves down faster than the upper one.
+// Fixed (was DISABLED: the sweeps reached their cap in step 1, 1075 penetrations, the upper
+// cube went on through the lower one): coplanar edge pairs that start touching took their
+// orientation from x_new, which the neighbours' projections flip every sweep, and edge pairs
+// left crossed pulled the cubes together; DCR now orients pairs by the outward normals
+// (kernels/dcr.hpp dcr_orientation). Measured: vz -0.807 / -0.193 (middle), -0.804 / -0.196
+// (end). The energy bound of 3 % holds with contact.placement: middle (+0.14 %); the end
+// placement loses 5.4 % on this coarse mesh (2 elements per edge; the same with a 1e-7 m gap:
+// it is the end placement's impact loss of docs/contact.md, not the coincidence), held to 8 %.
+TEST(Extreme, BodiesTouchingAtStart) {
+  for (const auto& [placement, energy_tol] : {std::pair{"middle", 0.03}, std::pair{"end", 0.08}}) {
+    SCOPED_TRACE(placement);
+    Model m = build_model(scene_from_text(
+        "touching", two_body_scene("touching", kSoft,
+                                   "{name: lower, material: soft, mesh: {shape: box, size: [0.02, "
+                                   "0.02, 0.02], center: [0, 0, -0.01], "
+                                   "element_size: 0.01}}",
+                                   "{name: upper, material: soft, mesh: {shape: box, size: [0.02, "
+                                   "0.02, 0.02], center: [0.005, 0, 0.01], "
+                                   "element_size: 0.01}, initial_velocity: [0, 0, -1]}",
+                                   std::string("{friction: 0.0, restitution: 1.0, placement: ") +
+                                       placement + "}")));
+    Simulation sim(m, {});
+    sim.step();
+    EXPECT_GT(sim.ledger().contacts, 0) << "no contact in the first step";
+    const Watch w = run_watched(sim, 2e-3);
+    std::printf(
+        "touching (%s): %ld steps, contact steps %ld, capped %ld, energy error max %.3e final "
+        "%+.3e, vz "
+        "%.3f %.3f\n",
+        placement, w.steps, w.contact_steps, sim.ledger().contact_capped_steps, w.max_energy_error,
+        sim.energy_error(), body_velocity(sim, 0).z(), body_velocity(sim, 1).z());
+    expect_clean(w, energy_tol);
+    EXPECT_EQ(sim.ledger().contact_capped_steps, 0);
+    EXPECT_LT(body_velocity(sim, 0).z(), body_velocity(sim, 1).z());
+    EXPECT_GT(body_centre(sim, 1).z() - body_centre(sim, 0).z(), 0.02 * (1 - 1e-3));
+  }
 }
 
 namespace {
@@ -401,11 +409,13 @@ TEST(Extreme, GrazingFacesAtTinyGapSlideUndisturbed) {
 }
 
 // Exactly in the plane (zero gap): the grazing limit of contact.
-// DEFECT (measured at this commit): the DCR sweeps reach their cap in the first step,
-// 28596 vertex-in-tet penetrations over the run, the slider is stopped to 0.15 m/s and
-// kicked 0.06 m/s out of the plane, the ledger is off by 9.9 %: the coplanar
-// touching faces of DISABLED_BodiesTouchingAtStart.
-TEST(Extreme, DISABLED_GrazingFacesInContactSlideUndisturbed) {
+// Fixed (was DISABLED: the sweeps reached their cap in step 1, 28596 penetrations, the
+// slider stopped to 0.15 m/s and kicked 0.06 m/s out of the plane): the coincident faces of
+// BodiesTouchingAtStart, plus two grazes the pair tests took for contacts (a vertex of the
+// block's face on the edge of the slider's side face; the end of the slider's vertical edge
+// passing over an edge of the block's face). Measured: no contact pair in 5747 steps,
+// velocities kept to 1e-28, energy 1.9e-12.
+TEST(Extreme, GrazingFacesInContactSlideUndisturbed) {
   expect_undisturbed(grazing("grazing_touch", 0.0));
 }
 
@@ -558,6 +568,45 @@ const std::array<Vec3, 4> kNeedle = {Vec3(0, 0, 0), Vec3(kThin, 0, 1),
                                      Vec3(-0.5 * kThin, -0.866 * kThin, 1)};
 
 }  // namespace
+
+// A real inelastic impact still books its loss (docs/contact.md "The ledger with e < 1"):
+// the apex of a single tet strikes a plate held fixed at 1 m/s, e = 0.5 (e = 1 for
+// comparison), no gravity, a fixed step of 1/20 of the stable one. The apex's impact on the
+// fixed face is a one-node collision: its relative normal kinetic energy is m_apex v^2 / 2
+// and e keeps e^2 of it, so the contact step must book (1 - e^2) m_apex v^2 / 2 to within
+// the first-order work term the ledger adds (measured 2e-5 of it at this step); e = 1 books 0.
+TEST(Extreme, InelasticImpactBooksItsKineticEnergyLoss) {
+  const double v = 1.0;
+  for (const double e : {0.5, 1.0}) {
+    SCOPED_TRACE(e);
+    const std::string file =
+        one_tet("apex_down", mirrored(kApexUp), kTet, Vec3(0.002, 0.001, 1e-3 * kTet));
+    const std::string yaml =
+        two_body_scene("apex", kSoft,
+                       "{name: plate, material: soft, mesh: {shape: box, size: [0.04, 0.04, 0.02], "
+                       "center: [0, 0, -0.01], element_size: 0.01}}",
+                       "{name: tet, material: soft, mesh: {file: " + file +
+                           "}, initial_velocity: [0, 0, " + num(-v) + "]}",
+                       "{friction: 0.0, restitution: " + num(e) + "}") +
+        "boundary_conditions:\n  - {body: plate, region: {box: [[-1, -1, -1], [1, 1, 1.0e-7]]}, "
+        "velocity: [0, 0, 0]}\n";
+    Model m = build_model(scene_from_text("apex", yaml));
+    m.scene.fixed_dt = 0.05 * Simulation(m, RunOptions{}).stable_dt() / m.scene.safety;
+    Simulation sim(m, {});
+    Index apex = -1;
+    for (Index i = 0; i < m.mesh.num_nodes(); ++i)
+      if (m.mesh.node_body[i] == 1 &&
+          (apex < 0 || sim.positions()[i].z() < sim.positions()[apex].z()))
+        apex = i;
+    while (sim.ledger().contacts == 0 && sim.time() < 1.0) sim.step();
+    const double expected = 0.5 * (1 - e * e) * m.mass[apex] * v * v;
+    std::printf("apex impact, e = %g: booked %.6e J, (1 - e^2) m v^2 / 2 = %.6e J, apex vz %.4f\n",
+                e, sim.ledger().contact_dissipated, expected, sim.velocities()[apex].z());
+    ASSERT_GT(sim.ledger().contacts, 0);
+    EXPECT_CLOSE(sim.ledger().contact_dissipated, expected, 0.01, 1e-12 * m.mass[apex] * v * v);
+    EXPECT_CLOSE(sim.velocities()[apex].z(), e * v, 0.01, 0);
+  }
+}
 
 // A sliver (four nearly coplanar vertices, height 1/100 of the width: its smallest
 // altitude sets a step 25 x shorter than the block's) and a needle (base 1/100 of its
@@ -723,11 +772,14 @@ TEST(Extreme, DISABLED_AdaptiveStepFreeVibrationDrifts) {
 
 // Three cubes stacked on a plate held fixed, under gravity, with the seeds' cube
 // material (E = 21000, rho = 0.0785, edge 1; mu = 0.5, e = 0), each set 1e-4 above the
-// one below (exactly touching at t = 0 is DISABLED_BodiesTouchingAtStart's defect).
-// Set down without velocity, the stack must settle and stay: the kinetic energy late in
-// the run must be below its early peak (no jitter growth), and the top cube's centre
+// one below. Set down without velocity, the stack must settle and stay: the kinetic energy
+// late in the run must be below its early peak (no jitter growth), and the top cube's centre
 // must end where the gaps closed and the elastic compression put it,
 // 2.5 - (2.5 + 1.5 + 0.25) rho g L / E = 2.5 - 1.56e-4, within 1e-4 (no sinking).
+// The ledger stays within 2e-4 m g L (measured -5.4e-5 J = 7e-5 m g L; the set-down frees
+// m g x the closed gaps, 4.6e-4 J, which e = 0 dissipates): it books the impulses' loss in
+// resting contact together with the work of the contact's moves (docs/contact.md "The ledger
+// with e < 1"); with the loss alone it gained 1.8e-2 J while the stack rested.
 TEST(Extreme, StackedCubesRestUnderGravity) {
   const int n_cubes = 3;
   const double gap = 1e-4;
@@ -750,6 +802,7 @@ TEST(Extreme, StackedCubesRestUnderGravity) {
           "gravity: [0, 0, -9.81]\ncontact: {friction: 0.5, restitution: 0.0}\n");
   Simulation& sim = *r.sim;
   const Vec3 top0 = body_centre(sim, n_cubes);
+  const double total0 = sim.ledger().total();
   // Kinetic energy: largest over the first and the last fifth of the run.
   double ke_early = 0, ke_late = 0;
   int penetrations = 0;
@@ -774,4 +827,5 @@ TEST(Extreme, StackedCubesRestUnderGravity) {
   EXPECT_EQ(penetrations, 0);
   EXPECT_LT(ke_late, ke_early);
   EXPECT_LT(std::abs(sink), 1e-4);
+  EXPECT_LT(std::abs(l.total() - total0), 2e-4 * rho * g);
 }

@@ -201,22 +201,24 @@ TEST(Scenes, JohnShahG05CrackStartsAtTheNotch) {
   EXPECT_GT(sim.time(), 0.05e-3);  // bending had to build up: not a shock at the load line
 }
 
-// Known defects, measured at commit ecfc919 (run with
-// --gtest_also_run_disabled_tests to see the figures):
+// Known defects, measured at the commit of the placement table in docs/contact.md (run
+// with --gtest_also_run_disabled_tests to see the figures):
 //   - angular momentum through contact, which DCR should keep to round-off
 //     (tests/runtime/test_contact_runs.cpp holds it to 1e-10 of sum m |x| |v|),
-//     changes by 1.9e-5 to 1.8e-4 of that scale in every scene here: the
-//     position projection of pairs left penetrating is not rotation-free;
-//   - the ledger total (with contact_dissipated) with friction drops:
-//     five_cubes_friction -6.5 %, spheres_impact_friction -2.6 % (their
-//     frictionless twins: -0.8 %, -0.9 %);
-//   - cubes76 (2 elements per cube edge, many repeated contacts): -10.9 %,
-//     a little with every contact.
+//     changes by 2.1e-5 to 1.8e-4 of that scale in every scene here: the
+//     position projection at fixed velocities is not rotation-free;
+//   - cubes76 (2 elements per cube edge, many repeated contacts): -11.2 %,
+//     a little with every contact (the end placement's impact loss).
+// Fixed since ecfc919: the ledger with friction (five_cubes_friction -6.5 % and
+// spheres_impact_friction -2.6 % then; now +0.09 % and +0.04 %: contact_dissipated
+// books the first-order work of the contact's moves with a dissipative law).
 // These scenes use the default collision placement (contact.placement: end).
-// With `middle` (docs/contact.md) the angular momentum changes 10-50x less
-// (1e-5 to 3e-5 of that scale: only the projections the impulse leaves) and
-// cubes76 ends +1.7 %, but five_cubes, spheres_impact and two_disks GAIN
-// 1.9-2.0 % and five_cubes_friction +4.2 %: still defects, of the other sign.
+// With `middle` the angular momentum changes 20-60x less (6.6e-7 to 4.8e-6 of that
+// scale: only the projections the impulse leaves) and cubes76 ends +1.4 %, but
+// five_cubes, spheres_impact and two_disks GAIN 2.0, 2.0 and 1.5 %; `impact` (the
+// impulse at the contact time) keeps L 3-10x worse than `middle` and gains up to
+// +19.6 % (five_cubes). No placement reaches round-off: only a projection that keeps
+// sum x x m v would.
 TEST(Scenes, DISABLED_KnownDefects) {
   for (const char* name : {"five_cubes", "five_cubes_friction", "spheres_impact", "spheres_impact_friction",
                            "two_disks", "cubes76"}) {

@@ -88,7 +88,7 @@ TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {
       {"search_margin_negative", kGood + "contact: {search_margin: -0.1}\n", {"contact.search_margin", ">= 0"}},
       {"fracture_check_every_fraction", replaced(kGood, "time: {", "time: {fracture_check_every: 2.5, "),
        {"time.fracture_check_every", "integer >= 1"}},
-      {"placement_unknown", kGood + "contact: {placement: start}\n", {"contact.placement", "one of end, middle"}},
+      {"placement_unknown", kGood + "contact: {placement: start}\n", {"contact.placement", "one of end, middle, impact"}},
       {"invalid_yaml", kGood + "time: [\n", {"not valid YAML"}},
       {"notch_outside_the_box",
        replaced(kGood, "element_size: 0.005}", "element_size: 0.005, notch: {center: [1, 0, 0], size: [0.002, 0.002, 0.02]}}"),
