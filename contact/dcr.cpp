@@ -48,13 +48,13 @@ Coloring color_found(const ContactPairs& pairs, std::span<const Index> found, st
 
 }  // namespace
 
-PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, std::span<const Vec3> x) {
+PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, const TriangleNormals& tn) {
   PairNormals N = PairNormals::Zero();
   if (!surface.surface) return N;
   const auto& n = pair.nodes;
   const bool vf = pair.kind == ContactPair::VertexFace;
-  N.col(0) = surface_normal(*surface.surface, *surface.around, x, n[0], vf ? -1 : n[1]);
-  if (!vf) N.col(1) = surface_normal(*surface.surface, *surface.around, x, n[2], n[3]);
+  N.col(0) = surface_normal(*surface.surface, *surface.around, tn, n[0], vf ? -1 : n[1]);
+  if (!vf) N.col(1) = surface_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
   return N;
 }
 
@@ -80,6 +80,8 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
   const DcrLaw law{options.restitution, options.friction, options.gap, options.placement};
   if (scratch.moved.size() < n_nodes) scratch.moved.resize(n_nodes, 0);
   if (scratch.slot.size() < n_nodes) scratch.slot.resize(n_nodes, -1);
+  // The outward normals orient the pairs at the start of the step.
+  const TriangleNormals tn = surface.surface ? triangle_normals(*surface.surface, x_old) : TriangleNormals{};
 
   DcrResult result;
   std::vector<Index> resolved;  // every pair resolved, with repeats
@@ -111,10 +113,8 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
           hit[k] = 3;
           continue;
         }
-        hit[k] = distinct_nodes(p) &&
-                         dcr_detect(dcr_kind(p), X_old, X_new, pair_normals(p, surface, x_old)).penetrating
-                     ? 2
-                     : 1;
+        const auto normals = [&] { return pair_normals(p, surface, tn); };
+        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals).penetrating ? 2 : 1;
       }
     });
     std::vector<Index> found;
@@ -149,7 +149,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
             w[i] = inv_mass[n];
           }
           const DcrPairResponse out =
-              dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, pair_normals(p, surface, x_old), w, law, 0.5 * dt);
+              dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, pair_normals(p, surface, tn), w, law, 0.5 * dt);
           if (!out.active) continue;
           active[f] = 1;
           dissipated[f] = out.impulse.dissipated;

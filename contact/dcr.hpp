@@ -57,9 +57,10 @@ struct DcrSurface {
   const VertexTriangles* around = nullptr;
 };
 
-/// The outward normals of a pair at x (surface_normal): a vertex-face pair's vertex normal
-/// (and 0), an edge-edge pair's normals of edge a and edge b; all 0 without a surface.
-PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, std::span<const Vec3> x);
+/// The outward normals of a pair (surface_normal, from the triangle normals tn of the
+/// configuration wanted): a vertex-face pair's vertex normal (and 0), an edge-edge pair's
+/// normals of edge a and edge b; all 0 without a surface.
+PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, const TriangleNormals& tn);
 
 /// Resolves the penetrations of one step (DESIGN.md step 2). Nodal arrays are indexed by
 /// the node ids of the pairs:

@@ -1,5 +1,8 @@
 #include "contact/surface.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <iterator>
 #include <tuple>
@@ -149,26 +152,42 @@ VertexTriangles vertex_triangles(const ContactSurface& surface) {
     out.items.push_back(t);
   }
   for (size_t k = 0; k < surface.vertices.size(); ++k) out.offsets[k + 1] += out.offsets[k];
+  out.position.assign(surface.vertices.empty() ? 0 : surface.vertices.back() + 1, -1);
+  for (size_t k = 0; k < surface.vertices.size(); ++k) out.position[surface.vertices[k]] = static_cast<Index>(k);
   return out;
 }
 
-Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around,
-                    std::span<const Vec3> x, Index node, Index other) {
-  const auto it = std::lower_bound(surface.vertices.begin(), surface.vertices.end(), node);
-  SHATTER_REQUIRE(it != surface.vertices.end() && *it == node &&
-                      around.offsets.size() == surface.vertices.size() + 1,
-                  "surface_normal: node "
-                      << node << " is not a vertex of the surface, or the vertex -> triangle "
-                      << "CSR is not the surface's");
-  const auto k = static_cast<size_t>(it - surface.vertices.begin());
+TriangleNormals triangle_normals(const ContactSurface& surface, std::span<const Vec3> x) {
+  TriangleNormals tn;
+  tn.normal.resize(surface.triangles.size());
+  tn.length.resize(surface.triangles.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        const auto& t = surface.triangles[i];
+                        tn.normal[i] = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+                        tn.length[i] = tn.normal[i].norm();
+                      }
+                    });
+  return tn;
+}
+
+Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around, const TriangleNormals& tn,
+                    Index node, Index other) {
+  SHATTER_REQUIRE(node >= 0 && static_cast<size_t>(node) < around.position.size() && around.position[node] >= 0 &&
+                      around.offsets.size() == surface.vertices.size() + 1 &&
+                      tn.normal.size() == surface.triangles.size(),
+                  "surface_normal: node " << node << " is not a vertex of the surface, or the vertex -> triangle "
+                                          << "CSR or the triangle normals are not the surface's");
+  const auto k = static_cast<size_t>(around.position[node]);
   Vec3 n = Vec3::Zero();
   double sum = 0;  // of the triangles' |normal|: what the two sides of a sheet cancel to round-off
   for (Index j = around.offsets[k]; j < around.offsets[k + 1]; ++j) {
-    const auto& t = surface.triangles[around.items[j]];
+    const Index i = around.items[j];
+    const auto& t = surface.triangles[i];
     if (other < 0 || t[0] == other || t[1] == other || t[2] == other) {
-      const Vec3 nt = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-      n += nt;
-      sum += nt.norm();
+      n += tn.normal[i];
+      sum += tn.length[i];
     }
   }
   return n.norm() > 1e-9 * sum ? n : Vec3::Zero();

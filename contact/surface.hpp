@@ -65,21 +65,31 @@ void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> tri
 ContactSurface make_contact_surface(std::span<const SurfaceTriangle> triangles);
 
 /// The triangles around each surface vertex, CSR over the positions in surface.vertices:
-/// the triangles of vertices[k] are items[offsets[k] .. offsets[k + 1]), ascending.
+/// the triangles of vertices[k] are items[offsets[k] .. offsets[k + 1]), ascending;
+/// position[n]: the k of mesh node n (-1 for a node off the surface; up to the largest vertex).
 struct VertexTriangles {
   std::vector<Index> offsets, items;
+  std::vector<Index> position;
 };
 
 /// The vertex -> triangle CSR of a surface, O(t log t).
 VertexTriangles vertex_triangles(const ContactSurface& surface);
 
+/// Each triangle's (x1 - x0) x (x2 - x0) at x (m^2) and its length, in surface order:
+/// computed once per configuration (oneTBB), so that surface_normal only adds them.
+struct TriangleNormals {
+  std::vector<Vec3> normal;
+  std::vector<double> length;
+};
+TriangleNormals triangle_normals(const ContactSurface& surface, std::span<const Vec3> x);
+
 /// Outward surface normal at a surface vertex `node` (m^2, not normalised): the sum of
 /// (x1 - x0) x (x2 - x0) over the triangles {x0, x1, x2} around it (twice the area-weighted
 /// mean of their unit normals), or, with `other` >= 0, over those that also hold `other`:
 /// the normal of the edge node-other (its one or two triangles). Where the two sides of a
-/// sheet meet they cancel: 0 when |sum| <= 1e-9 sum of |terms|. x: positions indexed by mesh node.
-/// DCR orients its pairs by them (kernels/dcr.hpp dcr_orientation).
-Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around,
-                    std::span<const Vec3> x, Index node, Index other = -1);
+/// sheet meet they cancel: 0 when |sum| <= 1e-9 sum of |terms|. tn: triangle_normals at the
+/// configuration wanted. DCR orients its pairs by them (kernels/dcr.hpp dcr_orientation).
+Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around, const TriangleNormals& tn,
+                    Index node, Index other = -1);
 
 }  // namespace shatter

@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <limits>
 
@@ -261,20 +262,36 @@ inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
 /// returns: g(X_new) > -tol), touching at the end (|g| <= tol), touching at the start
 /// (coincident faces) and degenerate geometry.
 /// tol = dcr_touch_tolerance(kind, X_old, X_new).
+/// normals: a callable returning the pair's PairNormals, called only for the few candidates
+/// that pass the cheap tests (at most once), so that a caller can compute them on demand.
+template <std::invocable Normals>
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                 const PairNormals& N) {
+                                 Normals&& normals) {
   DcrPenetration out;
-  // An exact exit before the tolerance (two square roots), for most vertex-face candidates:
-  // s V(X_new) < -tol needs V(X_new) > 0 (s = -1).
+  // Exact exits before the normals, in this order of cost. A vertex and a face (s = -1):
+  // s V(X_new) < -tol needs V(X_new) > 0. Two edges whose volume has the same sign at both
+  // ends and is not touching at the start: whatever s is, a penetration needs V to vanish
+  // inside the step (else g < -tol all along, or g > 0 at the end), which the cubic's
+  // coefficients exclude when |c0| > |c1| + |c2| + |c3|.
   const double V_new = pair_volume(X_new);
   if (kind == DcrPairKind::VertexFace && !(V_new > 0.0)) return out;
   const double tol = dcr_touch_tolerance(kind, X_old, X_new);
-  out.orientation = dcr_orientation(kind, X_old, N, tol);
+  const DcrCubic V = pair_volume_along(X_old, X_new - X_old);
+  if (kind == DcrPairKind::EdgeEdge && V.c0 * V_new > 0.0 && std::abs(V.c0) > tol &&
+      std::abs(V.c0) > std::abs(V.c1) + std::abs(V.c2) + std::abs(V.c3))
+    return out;
+  PairNormals N;
+  bool have_normals = false;
+  auto pair_normals = [&]() -> const PairNormals& {
+    if (!have_normals) N = normals();
+    have_normals = true;
+    return N;
+  };
+  out.orientation = kind == DcrPairKind::VertexFace ? -1.0 : dcr_orientation(kind, X_old, pair_normals(), tol);
   const double s = out.orientation;
   if (!(s * V_new < -tol)) return out;  // also s = 0
 
-  DcrCubic g = pair_volume_along(X_old, X_new - X_old);
-  g = {s * g.c0, s * g.c1, s * g.c2, s * g.c3};
+  const DcrCubic g{s * V.c0, s * V.c1, s * V.c2, s * V.c3};
   const bool touching = std::abs(g.c0) <= tol;
   std::array<double, 4> br;
   const int n = dcr_monotone_breaks(g, 0.0, 1.0, br);
@@ -295,7 +312,8 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   if (touching || margin <= kDcrInsideTolerance) {
     if (kind == DcrPairKind::VertexFace) {
       const Vec3 n_face = (X_old.col(2) - X_old.col(1)).cross(X_old.col(3) - X_old.col(1));
-      if (N.col(0).dot(n_face) > -kDcrFacingTolerance * N.col(0).norm() * n_face.norm()) return out;
+      const Vec3 n_vertex = pair_normals().col(0);
+      if (n_vertex.dot(n_face) > -kDcrFacingTolerance * n_vertex.norm() * n_face.norm()) return out;
     } else if (!(dcr_inside_margin(kind, X_new) >= -kDcrInsideTolerance)) {
       return out;
     }
@@ -303,6 +321,12 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   out.penetrating = true;
   out.time = t_star;
   return out;
+}
+
+/// dcr_detect with the pair's normals at hand.
+inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                 const PairNormals& N) {
+  return dcr_detect(kind, X_old, X_new, [&] { return N; });
 }
 
 /// Removes the penetration of a pair in place by the mass-weighted projection

@@ -290,6 +290,7 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
   const StackSurface other(split);
   const DcrResult r2 = run(split, options, even, [&](std::vector<Index>& found) {
     ++gathers;
+    const TriangleNormals tn = triangle_normals(other.surface, split.x_old);
     for (const Index i : odd) {
       const ContactPair& p = split.pairs[i];
       PairPoints X_old, X_new;
@@ -299,7 +300,7 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
       }
       const auto kind = p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
       if (pair_boxes_overlap(p.kind, X_old, X_new) &&
-          dcr_detect(kind, X_old, X_new, pair_normals(p, other.dcr(), split.x_old)).penetrating)
+          dcr_detect(kind, X_old, X_new, pair_normals(p, other.dcr(), tn)).penetrating)
         found.push_back(i);
     }
     std::sort(found.begin(), found.end());
