@@ -130,8 +130,23 @@ Simulation::Simulation(Model& model, RunOptions options)
 
 Simulation::~Simulation() = default;
 
-double Simulation::next_dt() const {
-  const double dt = model_.scene.fixed_dt ? *model_.scene.fixed_dt : model_.scene.safety * stable_dt_;
+double StepControl::next(double safe) {
+  if (dt > 0 && safe >= dt) {
+    window_min = std::min(window_min, safe);
+    if (++window_steps < kWindow) return dt;
+    // The end of a window of kWindow steps at this step.
+    dt = std::max(dt, std::min(kGrowth * dt, kHeadroom * window_min));
+  } else {
+    dt = dt > 0 ? kHeadroom * safe : safe;
+  }
+  window_min = HUGE_VAL;
+  window_steps = 0;
+  return dt;
+}
+
+double Simulation::next_dt() {
+  const double dt = model_.scene.fixed_dt ? *model_.scene.fixed_dt
+                                          : step_control_.next(model_.scene.safety * stable_dt_);
   const double remaining = model_.scene.end_time - time_;
   // Land on end_time exactly, without a sliver of a last step.
   return remaining < 1.5 * dt && remaining > dt ? 0.5 * remaining : std::min(dt, remaining);
@@ -374,6 +389,7 @@ void Simulation::save_state(SimulationState& s) const {
   s.time = time_;
   s.dt = dt_;
   s.stable_dt = stable_dt_;
+  s.step_control = step_control_;
   s.x = x_;
   s.v = v_;
   s.a = a_;
@@ -416,6 +432,7 @@ void Simulation::restore_state(const SimulationState& s) {
   time_ = s.time;
   dt_ = s.dt;
   stable_dt_ = s.stable_dt;
+  step_control_ = s.step_control;
   x_ = s.x;
   v_ = s.v;
   a_ = s.a;
