@@ -113,11 +113,13 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
             // Mid-surface normal from the corners, pointing from side 0 to side 1.
             std::array<Vec3, 3> mid;
             for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
-            const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
+            const Vec3 area_vector = (mid[1] - mid[0]).cross(mid[2] - mid[0]);
+            const Vec3 n = area_vector.normalized();
             Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
             std::fill(f, f + 2 * k, Vec3::Zero());
             CohesiveEnergy& energy = local_energy[c - first];
             energy = CohesiveEnergy{};
+            Vec3 dE_dn = Vec3::Zero();  // sum_q w_q dphi/dn, J
             for (int q = 0; q < kCohesivePoints; ++q) {
               const std::array<double, 6> N = facet_shape(facet_points()[q], k);
               Vec3 opening = Vec3::Zero();
@@ -132,6 +134,18 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
               }
               energy.stored += w * t.stored;
               energy.dissipated += w * t.dissipated;
+              dE_dn += w * t.dphi_dn;
+            }
+            // The normal follows the mid-surface corners m_j = (x0_j + x1_j) / 2:
+            // dn = (I - n n^T) dA / |A| with dA = dm_j x (m_{j+1} - m_{j+2}), so
+            // dE/dm_j = (m_{j+1} - m_{j+2}) x h, h = (I - n n^T) dE/dn / |A|, half
+            // to each side. With it the forces are the gradient of a rotation
+            // invariant energy: no net force and no net torque.
+            const Vec3 h = (dE_dn - dE_dn.dot(n) * n) / area_vector.norm();
+            for (int j = 0; j < 3; ++j) {
+              const Vec3 fj = 0.5 * (mid[(j + 1) % 3] - mid[(j + 2) % 3]).cross(h);
+              f[j] += fj;
+              f[k + j] += fj;
             }
           }
         });

@@ -82,7 +82,10 @@ struct CohesiveEnergy {
 /// Traction per unit reference area, integrated on the reference facet with
 /// the 3-point rule; the opening is interpolated with the facet's shape
 /// functions (linear, or quadratic on TET10 facets), the normal is that of the
-/// current mid-surface corner triangle (Ortiz & Pandolfi 1999, sec. 3).
+/// current mid-surface corner triangle (Ortiz & Pandolfi 1999, sec. 3). The
+/// forces are the full gradient of the cohesive energy at fixed delta_max,
+/// including the variation of the normal (CohesiveTraction::dphi_dn), so
+/// they keep linear and angular momentum.
 /// Element-local forces are computed with oneTBB and scattered in element
 /// order: bitwise identical for any number of threads.
 CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& cohesive,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -308,5 +309,73 @@ TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
                                         << sign << ": largest " << largest << ", bound " << bound);
         EXPECT_LE(largest, bound * (1 + 1e-6));
         EXPECT_GE(largest, 0.25 * bound);
+      }
+}
+
+// The nodal forces are the gradient of the cohesive energy at a fixed state,
+// the variation of the current normal included: central differences of the
+// stored energy (unloading, so delta_max stays), for beta != 1, openings in
+// tension and in compression, side 1 turned against side 0. And, the energy
+// being invariant under rotations, they exert no net torque about any point
+// (the term of the normal's variation balances Delta x T).
+TEST(CohesiveForces, ForcesAreTheEnergyGradientAndExertNoTorque) {
+  for (const Mesh& start : {two_tets(), two_tet10s()})
+    for (double beta : {0.6, 1.0, 1.5})
+      for (double sign : {1.0, -1.0}) {
+        Mesh m = start;
+        Topology t = build_topology(m);
+        CohesiveElements coh;
+        const CohesiveLaw law = make_cohesive_law(100.0, 1.0, beta, 1.0e7);
+        const auto laws = test::one_law(law);
+        insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
+        const int k = m.order == 1 ? 3 : 6;
+        std::vector<Vec3> x = m.reference;
+        std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+        // Load past the elastic rise (opening 0.5 delta_c, n = -z), then unload to
+        // a turned, less open (sign 1) or closed (sign -1) configuration away
+        // from the origin.
+        for (int j = 0; j < k; ++j)
+          x[coh.side_nodes[6 + j]] += 0.5 * law.delta_c * Vec3(0.6, 0, -0.8);
+        cohesive_forces(m, t, coh, laws, x, f);
+        const Mat3 turn =
+            Eigen::AngleAxisd(0.001, Vec3(0.3, 1, 0.2).normalized()).toRotationMatrix();
+        const Vec3 offset(2.0, -1.0, 0.5);
+        for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i] + offset;
+        for (int j = 0; j < k; ++j) {
+          Vec3& xj = x[coh.side_nodes[6 + j]];
+          xj = offset + turn * (xj - offset) + 0.1 * law.delta_c * Vec3(0.5, -0.3, -sign * 0.4);
+        }
+        auto energy = [&](const std::vector<Vec3>& y, std::vector<Vec3>& force) {
+          CohesiveElements state = coh;
+          std::fill(force.begin(), force.end(), Vec3::Zero());
+          const CohesiveEnergy e = cohesive_forces(m, t, state, laws, y, force);
+          EXPECT_EQ(state.delta_max, coh.delta_max) << "the probe reloaded the law";
+          return e.stored;
+        };
+        energy(x, f);
+        double f_scale = 0;
+        Vec3 torque = Vec3::Zero();
+        double torque_scale = 0;
+        for (Index i = 0; i < m.num_nodes(); ++i) {
+          f_scale = std::max(f_scale, f[i].norm());
+          torque += x[i].cross(f[i]);
+          torque_scale += x[i].norm() * f[i].norm();
+        }
+        SCOPED_TRACE(testing::Message()
+                     << "order " << m.order << " beta " << beta << " sign " << sign);
+        ASSERT_GT(f_scale, 0.0);
+        EXPECT_LT(torque.norm(), 1e-14 * torque_scale);
+        const double h = 1e-7;
+        std::vector<Vec3> scratch(m.num_nodes());
+        double err = 0;
+        for (Index i = 0; i < m.num_nodes(); ++i)
+          for (int d = 0; d < 3; ++d) {
+            std::vector<Vec3> xp = x, xm = x;
+            xp[i][d] += h;
+            xm[i][d] -= h;
+            const double fd = (energy(xp, scratch) - energy(xm, scratch)) / (2 * h);
+            err = std::max(err, std::abs(fd - f[i][d]));
+          }
+        EXPECT_LT(err, 1e-6 * f_scale);
       }
 }
