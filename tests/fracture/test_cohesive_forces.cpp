@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "expect_close.hpp"
 #include "fracture/cohesive_elements.hpp"
@@ -64,6 +65,31 @@ Mesh two_tet10s() {
   }
   m.build_node_elements();
   return m;
+}
+
+/// The two-element mesh with its facet made cohesive, law sigma_c = 100 Pa,
+/// Gc = 1 J/m^2, k_p = 1e7 Pa/m and a given beta.
+struct JoinedPair {
+  Mesh m;
+  Topology t;
+  CohesiveElements coh;
+  CohesiveLaw law;
+  std::vector<std::optional<CohesiveLaw>> laws;
+};
+
+/// Calls f(m, t, coh, law, laws, sign) of a JoinedPair for TET4 and TET10,
+/// beta 0.6, 1 and 1.5, sign +1 and -1.
+template <class F>
+void for_each_joined_pair(F f) {
+  for (const Mesh& start : {two_tets(), two_tet10s()})
+    for (double beta : {0.6, 1.0, 1.5})
+      for (double sign : {1.0, -1.0}) {
+        JoinedPair p{start, {}, {}, make_cohesive_law(100.0, 1.0, beta, 1.0e7), {}};
+        p.t = build_topology(p.m);
+        p.laws = test::one_law(p.law);
+        insert_cohesive_elements(p.m, p.t, p.coh, std::vector<Index>{p.t.elem_facet[3]});
+        f(p.m, p.t, p.coh, p.law, FractureLaws(p.laws), sign);
+      }
 }
 
 /// Open the facet of the two-element mesh by translating side 1 rigidly along
@@ -269,47 +295,38 @@ TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
   // rise, in tension and in compression): the largest eigenvalue of
   // M^-1/2 K M^-1/2 stays below cohesive_eigenvalue_bound, which the stable
   // step adds to the elements' omega^2, and the bound is not loose.
-  for (const Mesh& start : {two_tets(), two_tet10s()})
-    for (double beta : {0.6, 1.0, 1.5})
-      for (double sign : {1.0, -1.0}) {
-        Mesh m = start;
-        Topology t = build_topology(m);
-        CohesiveElements coh;
-        const CohesiveLaw law = make_cohesive_law(100.0, 1.0, beta, 1.0e7);
-        const auto laws = test::one_law(law);
-        insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
-        const std::vector<double> mass = test::lumped_masses(m, 1000.0);
-        const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
-        // Open side 1 by a fraction of delta_0 along a mixed direction.
-        std::vector<Vec3> x = m.reference;
-        const int k = m.order == 1 ? 3 : 6;
-        for (int j = 0; j < k; ++j)
-          x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
-        const Index ndof = 3 * m.num_nodes();
-        Eigen::MatrixXd K(ndof, ndof);
-        const double h = 1e-4 * law.delta_0();
-        for (Index d = 0; d < ndof; ++d) {
-          std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
-                            fm(m.num_nodes(), Vec3::Zero());
-          xp[d / 3][d % 3] += h;
-          xm[d / 3][d % 3] -= h;
-          CohesiveElements cp = coh, cm = coh;
-          cohesive_forces(m, t, cp, laws, xp, fp);
-          cohesive_forces(m, t, cm, laws, xm, fm);
-          for (Index r = 0; r < ndof; ++r)
-            K(r, d) = (fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h) /
-                      std::sqrt(mass[r / 3] * mass[d / 3]);
-        }
-        const Eigen::MatrixXd S = 0.5 * (K + K.transpose());
-        const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S)
-                                   .eigenvalues()
-                                   .cwiseAbs()
-                                   .maxCoeff();
-        SCOPED_TRACE(testing::Message() << "order " << m.order << " beta " << beta << " sign "
-                                        << sign << ": largest " << largest << ", bound " << bound);
-        EXPECT_LE(largest, bound * (1 + 1e-6));
-        EXPECT_GE(largest, 0.25 * bound);
-      }
+  for_each_joined_pair([](Mesh& m, Topology& t, CohesiveElements& coh, const CohesiveLaw& law,
+                          FractureLaws laws, double sign) {
+    const std::vector<double> mass = test::lumped_masses(m, 1000.0);
+    const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
+    // Open side 1 by a fraction of delta_0 along a mixed direction.
+    std::vector<Vec3> x = m.reference;
+    const int k = m.order == 1 ? 3 : 6;
+    for (int j = 0; j < k; ++j)
+      x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
+    const Index ndof = 3 * m.num_nodes();
+    Eigen::MatrixXd K(ndof, ndof);
+    const double h = 1e-4 * law.delta_0();
+    for (Index d = 0; d < ndof; ++d) {
+      std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
+                        fm(m.num_nodes(), Vec3::Zero());
+      xp[d / 3][d % 3] += h;
+      xm[d / 3][d % 3] -= h;
+      CohesiveElements cp = coh, cm = coh;
+      cohesive_forces(m, t, cp, laws, xp, fp);
+      cohesive_forces(m, t, cm, laws, xm, fm);
+      for (Index r = 0; r < ndof; ++r)
+        K(r, d) =
+            (fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h) / std::sqrt(mass[r / 3] * mass[d / 3]);
+    }
+    const Eigen::MatrixXd S = 0.5 * (K + K.transpose());
+    const double largest =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S).eigenvalues().cwiseAbs().maxCoeff();
+    SCOPED_TRACE(testing::Message() << "order " << m.order << " beta " << law.beta << " sign "
+                                    << sign << ": largest " << largest << ", bound " << bound);
+    EXPECT_LE(largest, bound * (1 + 1e-6));
+    EXPECT_GE(largest, 0.25 * bound);
+  });
 }
 
 // The nodal forces are the gradient of the cohesive energy at a fixed state,
@@ -319,63 +336,54 @@ TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
 // being invariant under rotations, they exert no net torque about any point
 // (the term of the normal's variation balances Delta x T).
 TEST(CohesiveForces, ForcesAreTheEnergyGradientAndExertNoTorque) {
-  for (const Mesh& start : {two_tets(), two_tet10s()})
-    for (double beta : {0.6, 1.0, 1.5})
-      for (double sign : {1.0, -1.0}) {
-        Mesh m = start;
-        Topology t = build_topology(m);
-        CohesiveElements coh;
-        const CohesiveLaw law = make_cohesive_law(100.0, 1.0, beta, 1.0e7);
-        const auto laws = test::one_law(law);
-        insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
-        const int k = m.order == 1 ? 3 : 6;
-        std::vector<Vec3> x = m.reference;
-        std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
-        // Load past the elastic rise (opening 0.5 delta_c, n = -z), then unload to
-        // a turned, less open (sign 1) or closed (sign -1) configuration away
-        // from the origin.
-        for (int j = 0; j < k; ++j)
-          x[coh.side_nodes[6 + j]] += 0.5 * law.delta_c * Vec3(0.6, 0, -0.8);
-        cohesive_forces(m, t, coh, laws, x, f);
-        const Mat3 turn =
-            Eigen::AngleAxisd(0.001, Vec3(0.3, 1, 0.2).normalized()).toRotationMatrix();
-        const Vec3 offset(2.0, -1.0, 0.5);
-        for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i] + offset;
-        for (int j = 0; j < k; ++j) {
-          Vec3& xj = x[coh.side_nodes[6 + j]];
-          xj = offset + turn * (xj - offset) + 0.1 * law.delta_c * Vec3(0.5, -0.3, -sign * 0.4);
-        }
-        auto energy = [&](const std::vector<Vec3>& y, std::vector<Vec3>& force) {
-          CohesiveElements state = coh;
-          std::fill(force.begin(), force.end(), Vec3::Zero());
-          const CohesiveEnergy e = cohesive_forces(m, t, state, laws, y, force);
-          EXPECT_EQ(state.delta_max, coh.delta_max) << "the probe reloaded the law";
-          return e.stored;
-        };
-        energy(x, f);
-        double f_scale = 0;
-        Vec3 torque = Vec3::Zero();
-        double torque_scale = 0;
-        for (Index i = 0; i < m.num_nodes(); ++i) {
-          f_scale = std::max(f_scale, f[i].norm());
-          torque += x[i].cross(f[i]);
-          torque_scale += x[i].norm() * f[i].norm();
-        }
-        SCOPED_TRACE(testing::Message()
-                     << "order " << m.order << " beta " << beta << " sign " << sign);
-        ASSERT_GT(f_scale, 0.0);
-        EXPECT_LT(torque.norm(), 1e-14 * torque_scale);
-        const double h = 1e-7;
-        std::vector<Vec3> scratch(m.num_nodes());
-        double err = 0;
-        for (Index i = 0; i < m.num_nodes(); ++i)
-          for (int d = 0; d < 3; ++d) {
-            std::vector<Vec3> xp = x, xm = x;
-            xp[i][d] += h;
-            xm[i][d] -= h;
-            const double fd = (energy(xp, scratch) - energy(xm, scratch)) / (2 * h);
-            err = std::max(err, std::abs(fd - f[i][d]));
-          }
-        EXPECT_LT(err, 1e-6 * f_scale);
+  for_each_joined_pair([](Mesh& m, Topology& t, CohesiveElements& coh, const CohesiveLaw& law,
+                          FractureLaws laws, double sign) {
+    const int k = m.order == 1 ? 3 : 6;
+    std::vector<Vec3> x = m.reference;
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    // Load past the elastic rise (opening 0.5 delta_c, n = -z), then unload to
+    // a turned, less open (sign 1) or closed (sign -1) configuration away
+    // from the origin.
+    for (int j = 0; j < k; ++j) x[coh.side_nodes[6 + j]] += 0.5 * law.delta_c * Vec3(0.6, 0, -0.8);
+    cohesive_forces(m, t, coh, laws, x, f);
+    const Mat3 turn = Eigen::AngleAxisd(0.001, Vec3(0.3, 1, 0.2).normalized()).toRotationMatrix();
+    const Vec3 offset(2.0, -1.0, 0.5);
+    for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i] + offset;
+    for (int j = 0; j < k; ++j) {
+      Vec3& xj = x[coh.side_nodes[6 + j]];
+      xj = offset + turn * (xj - offset) + 0.1 * law.delta_c * Vec3(0.5, -0.3, -sign * 0.4);
+    }
+    auto energy = [&](const std::vector<Vec3>& y, std::vector<Vec3>& force) {
+      CohesiveElements state = coh;
+      std::fill(force.begin(), force.end(), Vec3::Zero());
+      const CohesiveEnergy e = cohesive_forces(m, t, state, laws, y, force);
+      EXPECT_EQ(state.delta_max, coh.delta_max) << "the probe reloaded the law";
+      return e.stored;
+    };
+    energy(x, f);
+    double f_scale = 0;
+    Vec3 torque = Vec3::Zero();
+    double torque_scale = 0;
+    for (Index i = 0; i < m.num_nodes(); ++i) {
+      f_scale = std::max(f_scale, f[i].norm());
+      torque += x[i].cross(f[i]);
+      torque_scale += x[i].norm() * f[i].norm();
+    }
+    SCOPED_TRACE(testing::Message()
+                 << "order " << m.order << " beta " << law.beta << " sign " << sign);
+    ASSERT_GT(f_scale, 0.0);
+    EXPECT_LT(torque.norm(), 1e-14 * torque_scale);
+    const double h = 1e-7;
+    std::vector<Vec3> scratch(m.num_nodes());
+    double err = 0;
+    for (Index i = 0; i < m.num_nodes(); ++i)
+      for (int d = 0; d < 3; ++d) {
+        std::vector<Vec3> xp = x, xm = x;
+        xp[i][d] += h;
+        xm[i][d] -= h;
+        const double fd = (energy(xp, scratch) - energy(xm, scratch)) / (2 * h);
+        err = std::max(err, std::abs(fd - f[i][d]));
       }
+    EXPECT_LT(err, 1e-6 * f_scale);
+  });
 }
