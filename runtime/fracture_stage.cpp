@@ -69,9 +69,12 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
   return 2.0 / std::sqrt(omega_e * omega_e + eigenvalue_bound_);
 }
 
-Index FractureStage::release() {
+Index FractureStage::release(std::span<const Vec3> x) {
   if (cohesive_.size() == 0) return 0;
-  return release_debonded(model_.mesh, topology_, cohesive_, laws_);
+  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_, x);
+  // Freed facets exert no force: the eigenvalue bound no longer counts them.
+  if (freed > 0) bound_key_ = {-1, -1};
+  return freed;
 }
 
 void FractureStage::save(FractureState& s) const {

@@ -150,7 +150,9 @@ class Simulation {
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
   void write_outputs(bool fields);
-  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 2> contact_pairs_range);
+  /// `crack`: the crack surface at the end (fracture only; write_fragments).
+  void write_summary(double wall_seconds, const DecompositionStats& stats,
+                     std::array<long, 2> contact_pairs_range, const CrackArea& crack);
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
@@ -198,7 +200,9 @@ class Simulation {
   void apply_fracture();
   void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
   void node_arrays_from_model();
-  void write_fragments();
+  /// Writes fragments.csv from rank 0 (collective); returns the crack surface
+  /// between those fragments on rank 0, zeros elsewhere.
+  CrackArea write_fragments();
   /// x and v of every node on rank 0: the own arrays on one rank, else
   /// gathered from the owners into `x` and `v` (collective).
   std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);

@@ -211,7 +211,7 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
         inserted = true;
       }
     } else {
-      released = release_debonded(m, t, coh, laws) == 1;
+      released = release_debonded(m, t, coh, laws, x) == 1;
     }
   }
   ASSERT_TRUE(inserted);
@@ -226,6 +226,23 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
   ASSERT_EQ(fr.count(), 2);
   EXPECT_GT(fr.stats[0].velocity.z(), 0.0);  // element 1 (apex 4, above) moves up
   EXPECT_LT(fr.stats[1].velocity.z(), 0.0);
+  // The crack surface: the facet, debonded and between the two fragments; all
+  // the dissipated energy is in it. Joined again, it is no longer between fragments.
+  const CrackArea a = crack_area(m, t, coh, laws, fr.elem_fragment);
+  EXPECT_CLOSE(a.debonded, area, 1e-15, 0);
+  EXPECT_CLOSE(a.between_fragments, area, 1e-15, 0);
+  EXPECT_CLOSE(a.debonded_dissipated, energy.dissipated, 1e-15, 0);
+  const std::vector<Index> one_piece(m.num_elements(), 0);
+  EXPECT_EQ(crack_area(m, t, coh, laws, one_piece).between_fragments, 0.0);
+  // Freed, the facet exerts no force even when its faces are pushed through
+  // each other (the pieces it separated can fly anywhere), and keeps Gc x area.
+  for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i];
+  for (int j = 0; j < 3; ++j) x[coh.side_nodes[6 + j]] += Vec3(0.3, 0.1, 0.2);
+  std::vector<Vec3> f_free(m.num_nodes(), Vec3::Zero());
+  const CohesiveEnergy e_free = cohesive_forces(m, t, coh, laws, x, f_free);
+  for (const Vec3& fi : f_free) EXPECT_EQ(fi.norm(), 0.0);
+  EXPECT_EQ(e_free.stored, 0.0);
+  EXPECT_CLOSE(e_free.dissipated, expected, 1e-15, 0);
 }
 
 TEST(CohesiveForces, PrescribedMixedOpeningWorkIsGcTimesAreaTet4AndTet10) {
@@ -386,4 +403,33 @@ TEST(CohesiveForces, ForcesAreTheEnergyGradientAndExertNoTorque) {
       }
     EXPECT_LT(err, 1e-6 * f_scale);
   });
+}
+
+// A facet slid past delta_c while pressed shut is not freed: its compression
+// penalty holds energy that would vanish from the ledger with it. Opened, it is.
+TEST(CohesiveForces, DebondedFacetIsFreedOnlyOutOfCompression) {
+  Mesh m = two_tets();
+  Topology t = build_topology(m);
+  CohesiveElements coh;
+  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 1.0, 1.0e7);
+  const auto laws = test::one_law(law);
+  const Index facet = t.elem_facet[3];
+  insert_cohesive_elements(m, t, coh, std::vector<Index>{facet});
+  // n = -z (from element 0 above to element 1 below): +z on side 1 presses it shut.
+  for (double dz : {0.1, -0.1}) {
+    std::vector<Vec3> x = m.reference;
+    for (int j = 0; j < 3; ++j) x[coh.side_nodes[6 + j]] += law.delta_c * Vec3(1.5, 0, dz);
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    const CohesiveEnergy e = cohesive_forces(m, t, coh, laws, x, f);
+    EXPECT_CLOSE(e.dissipated, law.fracture_energy() * 0.5, 1e-14, 0);
+    if (dz > 0) {
+      EXPECT_GT(e.stored, 0.0);
+      EXPECT_EQ(release_debonded(m, t, coh, laws, x), 0);
+      EXPECT_EQ(t.facet_state[facet], FacetState::cohesive);
+    } else {
+      EXPECT_EQ(e.stored, 0.0);
+      EXPECT_EQ(release_debonded(m, t, coh, laws, x), 1);
+      EXPECT_EQ(t.facet_state[facet], FacetState::free);
+    }
+  }
 }
