@@ -67,8 +67,8 @@ Mesh two_tet10s() {
   return m;
 }
 
-/// The two-element mesh with its facet made cohesive, law sigma_c = 100 Pa,
-/// Gc = 1 J/m^2, k_p = 1e7 Pa/m and a given beta.
+/// The two-element mesh with its facet (face 3 of element 0, (0,2,1)) made
+/// cohesive, law sigma_c = 100 Pa, Gc = 1 J/m^2, k_p = 1e7 Pa/m and a given beta.
 struct JoinedPair {
   Mesh m;
   Topology t;
@@ -77,6 +77,14 @@ struct JoinedPair {
   std::vector<std::optional<CohesiveLaw>> laws;
 };
 
+JoinedPair joined_pair(const Mesh& start, double beta) {
+  JoinedPair p{start, {}, {}, make_cohesive_law(100.0, 1.0, beta, 1.0e7), {}};
+  p.t = build_topology(p.m);
+  p.laws = test::one_law(p.law);
+  insert_cohesive_elements(p.m, p.t, p.coh, std::vector<Index>{p.t.elem_facet[3]});
+  return p;
+}
+
 /// Calls f(m, t, coh, law, laws, sign) of a JoinedPair for TET4 and TET10,
 /// beta 0.6, 1 and 1.5, sign +1 and -1.
 template <class F>
@@ -84,10 +92,7 @@ void for_each_joined_pair(F f) {
   for (const Mesh& start : {two_tets(), two_tet10s()})
     for (double beta : {0.6, 1.0, 1.5})
       for (double sign : {1.0, -1.0}) {
-        JoinedPair p{start, {}, {}, make_cohesive_law(100.0, 1.0, beta, 1.0e7), {}};
-        p.t = build_topology(p.m);
-        p.laws = test::one_law(p.law);
-        insert_cohesive_elements(p.m, p.t, p.coh, std::vector<Index>{p.t.elem_facet[3]});
+        JoinedPair p = joined_pair(start, beta);
         f(p.m, p.t, p.coh, p.law, FractureLaws(p.laws), sign);
       }
 }
@@ -280,13 +285,8 @@ TEST(CohesiveForces, Tet10UniformOpeningLoadsOnlyMidEdgeNodes) {
 }
 
 TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
-  Mesh m = two_tets();
-  Topology t = build_topology(m);
-  CohesiveElements coh;
-  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 0.6, 1.0e7);
-  const auto laws = test::one_law(law);
-  const std::vector<Index> facet = {t.elem_facet[3]};  // face 3 of element 0 = (0,2,1)
-  insert_cohesive_elements(m, t, coh, facet);
+  JoinedPair p = joined_pair(two_tets(), 0.6);
+  const Mesh& m = p.m;
   ASSERT_EQ(m.num_nodes(), 8);
   std::vector<Vec3> x = m.reference;
   // A mixed opening with a rotation of side 1, then a compressed one.
@@ -294,7 +294,7 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
     for (Index n = 5; n < 8; ++n)
       x[n] = m.reference[n] + 1e-3 * Vec3(0.3 * n, -0.2, sign * (0.5 + 0.1 * n));
     std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
-    cohesive_forces(m, t, coh, laws, x, f);
+    cohesive_forces(m, p.t, p.coh, p.laws, x, f);
     Vec3 sum = Vec3::Zero();
     double scale = 0;
     for (const Vec3& fi : f) {
@@ -408,13 +408,13 @@ TEST(CohesiveForces, ForcesAreTheEnergyGradientAndExertNoTorque) {
 // A facet slid past delta_c while pressed shut is not freed: its compression
 // penalty holds energy that would vanish from the ledger with it. Opened, it is.
 TEST(CohesiveForces, DebondedFacetIsFreedOnlyOutOfCompression) {
-  Mesh m = two_tets();
-  Topology t = build_topology(m);
-  CohesiveElements coh;
-  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 1.0, 1.0e7);
-  const auto laws = test::one_law(law);
-  const Index facet = t.elem_facet[3];
-  insert_cohesive_elements(m, t, coh, std::vector<Index>{facet});
+  JoinedPair p = joined_pair(two_tets(), 1.0);
+  const Mesh& m = p.m;
+  Topology& t = p.t;
+  CohesiveElements& coh = p.coh;
+  const CohesiveLaw& law = p.law;
+  const FractureLaws laws = p.laws;
+  const Index facet = p.coh.facet[0];
   // n = -z (from element 0 above to element 1 below): +z on side 1 presses it shut.
   for (double dz : {0.1, -0.1}) {
     std::vector<Vec3> x = m.reference;
