@@ -170,7 +170,9 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
             // dE/dm_j = (m_{j+1} - m_{j+2}) x h, h = (I - n n^T) dE/dn / |A|, half
             // to each side. With it the forces are the gradient of a rotation
             // invariant energy: no net force and no net torque.
-            const Vec3 h = (dE_dn - dE_dn.dot(n) * n) / fs.area_vector.norm();
+            // (A mid-surface of zero area has no normal: n = 0 above, and no term.)
+            const double area = fs.area_vector.norm();
+            const Vec3 h = area > 0 ? Vec3((dE_dn - dE_dn.dot(n) * n) / area) : Vec3::Zero();
             for (int j = 0; j < 3; ++j) {
               const Vec3 fj = 0.5 * (mid[(j + 1) % 3] - mid[(j + 2) % 3]).cross(h);
               f[j] += fj;

@@ -433,3 +433,22 @@ TEST(CohesiveForces, DebondedFacetIsFreedOnlyOutOfCompression) {
     }
   }
 }
+
+// Side 1 turned half a turn about the facet's centroid: the mid-surface collapses to
+// a point and has no normal. The forces stay finite (and balanced).
+TEST(CohesiveForces, CollapsedMidSurfaceGivesFiniteForces) {
+  JoinedPair p = joined_pair(two_tets(), 1.0);
+  std::vector<Vec3> x = p.m.reference;
+  Vec3 centre = Vec3::Zero();
+  for (int j = 0; j < 3; ++j) centre += x[p.coh.side_nodes[j]] / 3;
+  for (int j = 0; j < 3; ++j) x[p.coh.side_nodes[6 + j]] = 2 * centre - x[p.coh.side_nodes[j]];
+  std::vector<Vec3> f(p.m.num_nodes(), Vec3::Zero());
+  const CohesiveEnergy e = cohesive_forces(p.m, p.t, p.coh, p.laws, x, f);
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& fi : f) {
+    EXPECT_TRUE(fi.allFinite());
+    sum += fi;
+  }
+  EXPECT_TRUE(std::isfinite(e.stored));
+  EXPECT_LT(sum.norm(), 1e-12);
+}
