@@ -16,8 +16,10 @@
 # against Grady s_G = (24 Gc / (rho rate^2))^(1/3) and ZMR
 # s = s0 4.5 / (1 + 4.5 (rate/eps0)^(2/3)), s0 = E Gc / sigma_c^2,
 # eps0 = c sigma_c^3 / (E^2 Gc), c = sqrt(E/rho). Also: the energy ledger
-# error, cohesive_dissipated against Gc x N a^2 (N through-cracks of area a^2),
-# fragment counts over time (plateau), single-element fragments.
+# error, cohesive_dissipated against Gc x N a^2 (N through-cracks of area a^2)
+# and its split (summary.json's crack areas: through-cracks, debonded facets
+# inside fragments, facets opened partway), fragment counts over time
+# (plateau), single-element fragments.
 # Run:     bash bench/expanding_ring.sh BUILD_DIR [RUN_DIR]
 #          (RUN_DIR keeps every run's outputs; default /tmp/expanding_ring_runs)
 # Output:  bench/results/expanding_ring.csv, docs/plots/expanding_ring.png,
@@ -36,7 +38,7 @@ csv="$here/results/expanding_ring.csv"
 # name rate a h end_time
 cases=(
   "r1e4_h100 1.0e4 2.0e-4 1.0e-4 3.0e-6"
-  "r1e4_h50 1.0e4 2.0e-4 5.0e-5 2.0e-6"
+  "r1e4_h50 1.0e4 2.0e-4 5.0e-5 3.0e-6"
   "r1e5_h50 1.0e5 1.0e-4 5.0e-5 6.0e-7"
   "r1e5_h25 1.0e5 1.0e-4 2.5e-5 8.0e-7"
   # other Gmsh meshes of nearly the same size: the spread of the counts
@@ -104,7 +106,12 @@ for name, rate, a, h, tend in cases:
         ratio_N_zmr=s_N / zmr(rate), ratio_big_zmr=s_big / zmr(rate), ratio_big_grady=s_big / grady(rate), ratio_N_grady=s_N / grady(rate), ratio_m_zmr=s_m / zmr(rate),
         zmr_over_h=zmr(rate) / h, cohesive_elements=sm["cohesive_elements"],
         dissipated=diss, gc_crack_area=Gc * N * A, dissipated_ratio=diss / (Gc * N * A), dissipated_ratio_big=diss / (Gc * max(big, 1) * A),
-        kinetic0=kin0, energy_error=sm["energy_error"], wall_time=sm["wall_time"]))
+        kinetic0=kin0, energy_error=sm["energy_error"], wall_time=sm["wall_time"],
+        # dissipated / (Gc N_big a^2) split: through-cracks (debonded facets between
+        # fragments), debonded facets inside a fragment, facets still cohesive
+        split_between=Gc * sm["crack_area_between_fragments"] / (Gc * max(big, 1) * A),
+        split_inside=Gc * (sm["crack_area_debonded"] - sm["crack_area_between_fragments"]) / (Gc * max(big, 1) * A),
+        split_partial=(diss - sm["cohesive_dissipated_debonded"]) / (Gc * max(big, 1) * A)))
     hist[name] = (t, nf, [float(r["cohesive_dissipated"]) for r in hs])
     masses[name] = (sorted(Li), h)
 
@@ -122,6 +129,10 @@ for r in rows:
     print(f"| {r['name']} | {r['rate']:.0e} | {r['h']*1e6:.1f} | {r['zmr_over_h']:.1f} | {r['elements']} | {r['fragments']} ({r['fragments_big']}, {r['single_element']}) "
           f"| {r['s_N']*1e3:.3f} | {r['s_big']*1e3:.3f} | {r['s_mass']*1e3:.3f} | {r['grady']*1e3:.3f} | {r['zmr']*1e3:.3f} | {r['ratio_big_zmr']:.2f} "
           f"| {r['ratio_big_grady']:.2f} | {r['dissipated_ratio_big']:.2f} | {r['energy_error']:.1e} | {r['wall_time']:.0f} |")
+print("| run | dissipated / (Gc N_big a^2) | through-cracks | debonded inside fragments | still cohesive (opened partway) |")
+print("|---|---|---|---|---|")
+for r in rows:
+    print(f"| {r['name']} | {r['dissipated_ratio_big']:.2f} | {r['split_between']:.2f} | {r['split_inside']:.2f} | {r['split_partial']:.2f} |")
 for r in rows:
     print(f"{r['name']}: last change of the fragment count at {r['last_change']*1e6:.3f} us of {r['end_time']*1e6:.2f} us; "
           f"count at 70 % of the run {r['fragments_at_70pct']}, at the end {r['fragments']}")

@@ -41,6 +41,31 @@ void refresh_side_nodes(const Mesh& mesh, const Topology& topo, CohesiveElements
     }
 }
 
+/// Where cohesive element c is at positions x: its mid-surface corners
+/// (averages of the two sides' corners), their area vector (its direction is
+/// the normal, from side 0 to side 1) and the opening x(side 1) - x(side 0)
+/// at each quadrature point.
+struct FacetKinematics {
+  std::array<Vec3, 3> mid;
+  Vec3 area_vector;
+  std::array<Vec3, kCohesivePoints> opening;
+};
+
+FacetKinematics facet_kinematics(const CohesiveElements& coh, Index c, int k,
+                                 std::span<const Vec3> x) {
+  const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
+  const Index* side1 = side0 + kSlots;
+  FacetKinematics s;
+  for (int j = 0; j < 3; ++j) s.mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
+  s.area_vector = (s.mid[1] - s.mid[0]).cross(s.mid[2] - s.mid[0]);
+  for (int q = 0; q < kCohesivePoints; ++q) {
+    const std::array<double, 6> N = facet_shape(facet_points()[q], k);
+    s.opening[q] = Vec3::Zero();
+    for (int j = 0; j < k; ++j) s.opening[q] += N[j] * (x[side1[j]] - x[side0[j]]);
+  }
+  return s;
+}
+
 }  // namespace
 
 Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& coh,
@@ -108,22 +133,28 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
             const CohesiveLaw* law_ptr = facet_law(mesh, topo, laws, coh.facet[c]);
             SHATTER_ASSERT(law_ptr);  // insertion happens only where the criterion has a law
             const CohesiveLaw& law = *law_ptr;
-            const Index* side0 = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
-            const Index* side1 = side0 + kSlots;
-            // Mid-surface normal from the corners, pointing from side 0 to side 1.
-            std::array<Vec3, 3> mid;
-            for (int j = 0; j < 3; ++j) mid[j] = 0.5 * (x[side0[j]] + x[side1[j]]);
-            const Vec3 n = (mid[1] - mid[0]).cross(mid[2] - mid[0]).normalized();
             Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
             std::fill(f, f + 2 * k, Vec3::Zero());
             CohesiveEnergy& energy = local_energy[c - first];
             energy = CohesiveEnergy{};
+            if (topo.facet_state[coh.facet[c]] == FacetState::free) {
+              // Debonded: no traction is left, and no compression penalty either:
+              // its faces may have moved apart by many element sizes, where the
+              // mid-surface of the two defines no normal (a penalty on that
+              // "interpenetration" once reached 3700 sigma_c and inverted an
+              // element of the fine expanding ring, docs/validation.md). Crack
+              // faces meet through contact.
+              energy.dissipated = law.fracture_energy() * coh.area[c];
+              continue;
+            }
+            const FacetKinematics fs = facet_kinematics(coh, c, k, x);
+            const std::array<Vec3, 3>& mid = fs.mid;
+            const Vec3 n = fs.area_vector.normalized();
+            Vec3 dE_dn = Vec3::Zero();  // sum_q w_q dphi/dn, J
             for (int q = 0; q < kCohesivePoints; ++q) {
               const std::array<double, 6> N = facet_shape(facet_points()[q], k);
-              Vec3 opening = Vec3::Zero();
-              for (int j = 0; j < k; ++j) opening += N[j] * (x[side1[j]] - x[side0[j]]);
               double& delta_max = coh.delta_max[static_cast<size_t>(c) * kCohesivePoints + q];
-              const CohesiveTraction t = cohesive_traction(law, opening, n, delta_max);
+              const CohesiveTraction t = cohesive_traction(law, fs.opening[q], n, delta_max);
               delta_max = t.delta_max;
               const double w = coh.area[c] / kCohesivePoints;
               for (int j = 0; j < k; ++j) {
@@ -132,6 +163,20 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
               }
               energy.stored += w * t.stored;
               energy.dissipated += w * t.dissipated;
+              dE_dn += w * t.dphi_dn;
+            }
+            // The normal follows the mid-surface corners m_j = (x0_j + x1_j) / 2:
+            // dn = (I - n n^T) dA / |A| with dA = dm_j x (m_{j+1} - m_{j+2}), so
+            // dE/dm_j = (m_{j+1} - m_{j+2}) x h, h = (I - n n^T) dE/dn / |A|, half
+            // to each side. With it the forces are the gradient of a rotation
+            // invariant energy: no net force and no net torque.
+            // (A mid-surface of zero area has no normal: n = 0 above, and no term.)
+            const double area = fs.area_vector.norm();
+            const Vec3 h = area > 0 ? Vec3((dE_dn - dE_dn.dot(n) * n) / area) : Vec3::Zero();
+            for (int j = 0; j < 3; ++j) {
+              const Vec3 fj = 0.5 * (mid[(j + 1) % 3] - mid[(j + 2) % 3]).cross(h);
+              f[j] += fj;
+              f[k + j] += fj;
             }
           }
         });
@@ -191,15 +236,44 @@ std::vector<double> element_damage(const Mesh& mesh, const Topology& topo,
   return damage;
 }
 
+namespace {
+
+/// Cohesive element c has opened past delta_c at every point.
+bool debonded(const CohesiveElements& coh, Index c, const CohesiveLaw& law) {
+  const double* dm = coh.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+  return std::all_of(dm, dm + kCohesivePoints, [&](double d) { return d >= law.delta_c; });
+}
+
+}  // namespace
+
+CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveElements& coh,
+                     FractureLaws laws, std::span<const Index> elem_fragment) {
+  CrackArea a;
+  for (Index c = 0; c < coh.size(); ++c) {
+    const Index f = coh.facet[c];
+    const CohesiveLaw& law = *facet_law(mesh, topo, laws, f);
+    if (!debonded(coh, c, law)) continue;
+    a.debonded += coh.area[c];
+    a.debonded_dissipated += law.fracture_energy() * coh.area[c];
+    const auto [e0, e1] = topo.facet_elem[f];
+    if (elem_fragment[e0] != elem_fragment[e1]) a.between_fragments += coh.area[c];
+  }
+  return a;
+}
+
 Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,
-                       FractureLaws laws) {
+                       FractureLaws laws, std::span<const Vec3> x) {
+  const int k = mesh.order == 1 ? 3 : 6;
   Index freed = 0;
   for (Index c = 0; c < coh.size(); ++c) {
     const Index f = coh.facet[c];
-    if (topo.facet_state[f] != FacetState::cohesive) continue;
-    const double delta_c = facet_law(mesh, topo, laws, f)->delta_c;
-    const double* dm = coh.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
-    if (std::all_of(dm, dm + kCohesivePoints, [&](double d) { return d >= delta_c; })) {
+    if (topo.facet_state[f] != FacetState::cohesive ||
+        !debonded(coh, c, *facet_law(mesh, topo, laws, f)))
+      continue;
+    // Not while the compression penalty holds energy: it would vanish from the ledger.
+    const FacetKinematics fs = facet_kinematics(coh, c, k, x);
+    if (std::all_of(fs.opening.begin(), fs.opening.end(),
+                    [&](const Vec3& o) { return o.dot(fs.area_vector) >= 0; })) {
       topo.facet_state[f] = FacetState::free;
       ++freed;
     }

@@ -82,7 +82,12 @@ struct CohesiveEnergy {
 /// Traction per unit reference area, integrated on the reference facet with
 /// the 3-point rule; the opening is interpolated with the facet's shape
 /// functions (linear, or quadratic on TET10 facets), the normal is that of the
-/// current mid-surface corner triangle (Ortiz & Pandolfi 1999, sec. 3).
+/// current mid-surface corner triangle (Ortiz & Pandolfi 1999, sec. 3). The
+/// forces are the full gradient of the cohesive energy at fixed delta_max,
+/// including the variation of the normal (CohesiveTraction::dphi_dn), so
+/// they keep linear and angular momentum. A freed facet (release_debonded)
+/// exerts no force, not even the compression penalty, and counts Gc x area
+/// as dissipated.
 /// Element-local forces are computed with oneTBB and scattered in element
 /// order: bitwise identical for any number of threads.
 CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& cohesive,
@@ -110,10 +115,26 @@ double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
 std::vector<double> element_damage(const Mesh& mesh, const Topology& topo,
                                    const CohesiveElements& cohesive, FractureLaws laws);
 
+/// Crack surfaces of the cohesive elements (reference facet areas, m^2).
+struct CrackArea {
+  double debonded = 0;           ///< facets opened past delta_c at every point (no traction left)
+  double between_fragments = 0;  ///< the part of `debonded` between elements of different fragments
+  double debonded_dissipated = 0;  ///< Gc x area over the debonded facets, J (the rest of the
+                                   ///< dissipated energy is in facets still cohesive)
+};
+
+/// The crack surface of `cohesive`: debonded facets (every point past
+/// delta_c), and those of them whose two elements are in different fragments
+/// (`elem_fragment`, Fragments::elem_fragment): the through-cracks.
+CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveElements& cohesive,
+                     FractureLaws laws, std::span<const Index> elem_fragment);
+
 /// Mark free the cohesive facets whose every quadrature point has opened past
 /// delta_c (no traction left; the two sides now belong to separate fragments
-/// unless joined elsewhere). Returns the number of facets freed.
+/// unless joined elsewhere) and is not in compression at positions `x` (m),
+/// so that the penalty holds no energy when the facet stops acting
+/// (cohesive_forces). Returns the number of facets freed.
 Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive,
-                       FractureLaws laws);
+                       FractureLaws laws, std::span<const Vec3> x);
 
 }  // namespace shatter

@@ -103,7 +103,14 @@ inline double cohesive_stiffness_bound(const CohesiveLaw& law) {
 
 /// Result of one evaluation of the law at one point of a cohesive surface.
 struct CohesiveTraction {
-  Vec3 traction;      ///< T, Pa, acting on side 1 against the opening (side 0 gets -T)
+  Vec3 traction;  ///< T, Pa, acting on side 1 against the opening (side 0 gets -T)
+  /// dphi/dn, J/m^2: the derivative of the energy density phi(Delta, n) with
+  /// respect to the unit normal at fixed opening and state,
+  /// c Delta with c = (t/delta) (<delta_n> - beta^2 delta_n) + k_p min(delta_n, 0);
+  /// zero for beta = 1 in tension. Where n follows the deformation, the force
+  /// of this term (cohesive_forces) balances the torque Delta x T = -n x dphi/dn
+  /// (phi is invariant under rotations of both).
+  Vec3 dphi_dn;
   double delta_max;   ///< updated state: largest effective opening reached, m
   double stored;      ///< recoverable energy density, J/m^2
   double dissipated;  ///< dissipated energy density up to delta_max, J/m^2
@@ -125,10 +132,16 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   const double t_over_delta = cohesive_secant(law, out.delta_max);  // Pa/m
   out.traction = t_over_delta * (beta2 * delta_s + open_n * n);
   out.stored = 0.5 * t_over_delta * delta * delta;
+  // phi(Delta, n) depends on n through delta_n = Delta . n and |delta_s|^2 =
+  // |Delta|^2 - delta_n^2: dphi/dn = (t/delta (<delta_n> - beta^2 delta_n)
+  // + k_p min(delta_n, 0)) Delta.
+  double c = t_over_delta * (open_n - beta2 * delta_n);
   if (delta_n < 0) {
     out.traction += law.penalty * delta_n * n;
     out.stored += 0.5 * law.penalty * delta_n * delta_n;
+    c += law.penalty * delta_n;
   }
+  out.dphi_dn = c * opening;
   const double dm = out.delta_max;
   out.dissipated = dm >= law.delta_c ? law.fracture_energy()
                    : dm <= law.delta_0()

@@ -18,7 +18,7 @@ namespace {
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
 
 constexpr const char* kFormat = "shatter-checkpoint";
-constexpr long kVersion = 1;
+constexpr long kVersion = 2;  // 2: the step controller's state
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -273,6 +273,9 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.number(root, "time", s.time);
     w.number(root, "dt", s.dt);
     w.number(root, "stable_dt", s.stable_dt);
+    w.number(root, "control_dt", s.step_control.dt);
+    w.number(root, "control_window_min", s.step_control.window_min);
+    w.integer(root, "control_window_steps", s.step_control.window_steps);
     w.number(root, "total0", s.total0);
     w.number(root, "energy_scale", s.energy_scale);
     w.text(root, "failure", failure);
@@ -427,6 +430,9 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   s.time = r.number(root, "time");
   s.dt = r.number(root, "dt");
   s.stable_dt = r.number(root, "stable_dt");
+  s.step_control.dt = r.number(root, "control_dt");
+  s.step_control.window_min = r.number(root, "control_window_min");
+  s.step_control.window_steps = r.integer(root, "control_window_steps");
   s.total0 = r.number(root, "total0");
   s.energy_scale = r.number(root, "energy_scale");
   H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);

@@ -10,7 +10,7 @@
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
-//       version       int64 1
+//       version       int64 2 (1: before the step controller; refused)
 //       scene         string, Scene::name
 //       nodes         int64, nodes of the model as built (before fracture)
 //       elements      int64
@@ -19,6 +19,9 @@
 //       step          int64, steps done
 //       time, dt      float64, s: time reached, length of the last step
 //       stable_dt     float64, s: stable step of the state, no safety factor
+//       control_dt, control_window_min   float64, s; control_window_steps
+//                     int64: the step controller's state (StepControl,
+//                     simulation.hpp)
 //       total0, energy_scale   float64, J: Simulation::energy_error() reference
 //       failure       string: empty, or the error that stopped the run one
 //                     step after this (good) state

@@ -69,10 +69,10 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
   return 2.0 / std::sqrt(omega_e * omega_e + eigenvalue_bound_);
 }
 
-Index FractureStage::release() {
+Index FractureStage::release(std::span<const Vec3> x) {
   if (cohesive_.size() == 0) return 0;
-  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_);
-  released_ += freed;
+  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_, x);
+  released_ += freed;  // freed facets exert no force: the eigenvalue bound's key changes
   return freed;
 }
 

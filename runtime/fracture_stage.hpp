@@ -72,13 +72,18 @@ class FractureStage {
   /// recomputed when cohesive elements or nodes were added since the last call.
   double stable_dt(double element_dt, std::span<const double> mass);
 
-  /// Frees fully debonded facets; returns how many.
-  Index release();
+  /// Frees fully debonded facets not in compression at positions x (release_debonded); returns how
+  /// many.
+  Index release(std::span<const Vec3> x);
 
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
   Index cohesive_count() const { return cohesive_.size(); }
+  /// The crack surface (crack_area) with the fragments `frags` of the current state.
+  CrackArea crack_area(const Fragments& frags) const {
+    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws_, frags.elem_fragment);
+  }
   /// Per element damage in [0, 1] (element_damage), for output.
   std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws_); }
 

@@ -135,8 +135,23 @@ Simulation::Simulation(Model& model, RunOptions options)
 
 Simulation::~Simulation() = default;
 
-double Simulation::next_dt() const {
-  const double dt = model_.scene.fixed_dt ? *model_.scene.fixed_dt : model_.scene.safety * stable_dt_;
+double StepControl::next(double safe) {
+  if (dt > 0 && safe >= dt) {
+    window_min = std::min(window_min, safe);
+    if (++window_steps < kWindow) return dt;
+    // The end of a window of kWindow steps at this step.
+    dt = std::max(dt, std::min(kGrowth * dt, kHeadroom * window_min));
+  } else {
+    dt = dt > 0 ? kHeadroom * safe : safe;
+  }
+  window_min = HUGE_VAL;
+  window_steps = 0;
+  return dt;
+}
+
+double Simulation::next_dt() {
+  const double dt = model_.scene.fixed_dt ? *model_.scene.fixed_dt
+                                          : step_control_.next(model_.scene.safety * stable_dt_);
   const double remaining = model_.scene.end_time - time_;
   // Land on end_time exactly, without a sliver of a last step.
   return remaining < 1.5 * dt && remaining > dt ? 0.5 * remaining : std::min(dt, remaining);
@@ -304,7 +319,7 @@ void Simulation::step() {
 void Simulation::apply_fracture() {
   // Every rank holds the positions of every cohesive node (compute_forces),
   // so releases are the same everywhere.
-  fracture_->release();
+  fracture_->release(x_);
   std::vector<Index> critical = fracture_->check(x_, stress6_);
   if (dec_->distributed()) {
     // A facet is checked by the owner of its first element, which holds both
@@ -408,6 +423,7 @@ void Simulation::save_state(SimulationState& s) const {
   s.time = time_;
   s.dt = dt_;
   s.stable_dt = stable_dt_;
+  s.step_control = step_control_;
   s.x = x_;
   s.v = v_;
   s.a = a_;
@@ -450,6 +466,7 @@ void Simulation::restore_state(const SimulationState& s) {
   time_ = s.time;
   dt_ = s.dt;
   stable_dt_ = s.stable_dt;
+  step_control_ = s.step_control;
   x_ = s.x;
   v_ = s.v;
   a_ = s.a;
@@ -685,18 +702,18 @@ long Simulation::run() {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   fields_.reset();
   if (!opt_.out_dir.empty()) {
-    if (fracture_) write_fragments();
+    const CrackArea crack = fracture_ ? write_fragments() : CrackArea{};
     const DecompositionStats stats = dec_->stats();
     const std::array<long, 3> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 3>{};
-    if (root) write_summary(wall, stats, pairs);
+    if (root) write_summary(wall, stats, pairs, crack);
   }
   return step_;
 }
 
-void Simulation::write_fragments() {
+CrackArea Simulation::write_fragments() {
   std::vector<Vec3> x_all, v_all;
   const auto xv = root_state(x_all, v_all);
-  if (dec_->rank() != 0) return;
+  if (dec_->rank() != 0) return {};
   const Fragments frags = fracture_->fragments(xv[0], xv[1], model_.mass);
   CsvWriter out(opt_.out_dir / "fragments.csv",
                 {"id", "mass", "volume", "cx", "cy", "cz", "vx", "vy", "vz", "elements"});
@@ -706,9 +723,11 @@ void Simulation::write_fragments() {
         << s.velocity.x() << s.velocity.y() << s.velocity.z() << static_cast<long>(s.elements);
     out.end_row();
   }
+  return fracture_->crack_area(frags);
 }
 
-void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs) {
+void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs,
+                               const CrackArea& crack) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -761,6 +780,9 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
       across += dec_->granule_rank(fe[0] / ElementForces::kGranule) != dec_->granule_rank(fe[1] / ElementForces::kGranule);
     }
     j.add("cohesive_elements_across_ranks", across);
+    j.add("crack_area_debonded", crack.debonded);
+    j.add("crack_area_between_fragments", crack.between_fragments);
+    j.add("cohesive_dissipated_debonded", crack.debonded_dissipated);
   }
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());

@@ -10,6 +10,7 @@
 //   6. ledger, output, progress
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -62,6 +63,41 @@ struct Ledger {
   }
 };
 
+/// Control of the adaptive step (docs/physics.md "Step control"). Central
+/// difference is symplectic at a fixed step; a step re-evaluated from the
+/// state every step follows the vibration of the element that sets it, and
+/// the map is no longer symplectic: the energy drifts (Skeel, BIT 33 (1993)
+/// 172; Calvo & Sanz-Serna, SIAM J. Sci. Comput. 14 (1993) 936; Hairer,
+/// Lubich & Wanner, Geometric Numerical Integration, 2nd ed. 2006, sec. VIII.1).
+/// So the step is held constant and changes only
+///   - down, when the safe step (safety x stable step of the state at the
+///     start of a step) falls below it: to kHeadroom x the safe step, so a
+///     vibration of the safe step by less than the headroom does not move it
+///     again (the step is then the running minimum of the safe step, less the
+///     headroom: a monotone sequence);
+///   - up, at the end of a window of kWindow steps (counted from the last
+///     change or window) in which the safe step stayed above dt / kHeadroom:
+///     to min(kGrowth x dt, kHeadroom x the window's smallest safe step).
+/// The step taken is never above the safe step. Each change shifts the
+/// modified energy that a fixed step conserves by O(omega^2 |d(dt^2)|); a
+/// monotone sequence of drops shifts it by at most O(omega^2 dt0^2) in all and
+/// growth happens at most once per kWindow steps, so the energy error stays
+/// bounded instead of drifting. The state is deterministic (the safe step is
+/// a minimum over all ranks) and is part of a checkpoint.
+struct StepControl {
+  static constexpr double kHeadroom = 0.95;
+  static constexpr long kWindow = 1000;
+  static constexpr double kGrowth = 1.1;
+
+  double dt = 0;                 ///< s: the step held
+  double window_min = HUGE_VAL;  ///< s: smallest safe step in the current window
+  long window_steps = 0;         ///< steps in the current window
+
+  /// The step to take from a state whose safe step is `safe` (s); advances
+  /// the controller. The first call (dt = 0) takes the safe step.
+  double next(double safe);
+};
+
 /// The complete state of a run between two steps: what a checkpoint holds
 /// (runtime/checkpoint.hpp). Per-node arrays [n] in the model's node order
 /// (with fracture, n counts the split copies); reaction [b] per node with a
@@ -70,6 +106,7 @@ struct SimulationState {
   long step = 0;
   double time = 0, dt = 0;    ///< s: time reached, length of the last step
   double stable_dt = 0;       ///< s: stable step of this state, without the safety factor
+  StepControl step_control;   ///< the adaptive step's controller
   std::vector<Vec3> x, v, a;  ///< positions m, velocities m/s, accelerations m/s^2
   std::vector<Vec3> f_int, f_ext, reaction;  ///< N
   Ledger ledger;
@@ -123,12 +160,15 @@ class Simulation {
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
   void write_outputs(bool fields);
-  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range);
+  /// `crack`: the crack surface at the end (fracture only; write_fragments).
+  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range,
+                     const CrackArea& crack);
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
   void save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason = "");
-  double next_dt() const;
+  /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.
+  double next_dt();
 
   /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
   /// strain, the step's gravity work, the step's reaction work, the step's contact work
@@ -150,6 +190,7 @@ class Simulation {
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
   std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
   double time_ = 0, dt_ = 0, stable_dt_ = 0;
+  StepControl step_control_;
   long step_ = 0;
   Ledger ledger_;
   ElementLoopResult last_elements_;
@@ -176,7 +217,9 @@ class Simulation {
   void apply_fracture();
   void grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes);
   void node_arrays_from_model();
-  void write_fragments();
+  /// Writes fragments.csv from rank 0 (collective); returns the crack surface
+  /// between those fragments on rank 0, zeros elsewhere.
+  CrackArea write_fragments();
   /// x and v of every node on rank 0: the own arrays on one rank, else
   /// gathered from the owners into `x` and `v` (collective).
   std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "expect_close.hpp"
 #include "fracture/cohesive_elements.hpp"
@@ -63,6 +65,36 @@ Mesh two_tet10s() {
   }
   m.build_node_elements();
   return m;
+}
+
+/// The two-element mesh with its facet (face 3 of element 0, (0,2,1)) made
+/// cohesive, law sigma_c = 100 Pa, Gc = 1 J/m^2, k_p = 1e7 Pa/m and a given beta.
+struct JoinedPair {
+  Mesh m;
+  Topology t;
+  CohesiveElements coh;
+  CohesiveLaw law;
+  std::vector<std::optional<CohesiveLaw>> laws;
+};
+
+JoinedPair joined_pair(const Mesh& start, double beta) {
+  JoinedPair p{start, {}, {}, make_cohesive_law(100.0, 1.0, beta, 1.0e7), {}};
+  p.t = build_topology(p.m);
+  p.laws = test::one_law(p.law);
+  insert_cohesive_elements(p.m, p.t, p.coh, std::vector<Index>{p.t.elem_facet[3]});
+  return p;
+}
+
+/// Calls f(m, t, coh, law, laws, sign) of a JoinedPair for TET4 and TET10,
+/// beta 0.6, 1 and 1.5, sign +1 and -1.
+template <class F>
+void for_each_joined_pair(F f) {
+  for (const Mesh& start : {two_tets(), two_tet10s()})
+    for (double beta : {0.6, 1.0, 1.5})
+      for (double sign : {1.0, -1.0}) {
+        JoinedPair p = joined_pair(start, beta);
+        f(p.m, p.t, p.coh, p.law, FractureLaws(p.laws), sign);
+      }
 }
 
 /// Open the facet of the two-element mesh by translating side 1 rigidly along
@@ -184,7 +216,7 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
         inserted = true;
       }
     } else {
-      released = release_debonded(m, t, coh, laws) == 1;
+      released = release_debonded(m, t, coh, laws, x) == 1;
     }
   }
   ASSERT_TRUE(inserted);
@@ -199,6 +231,23 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
   ASSERT_EQ(fr.count(), 2);
   EXPECT_GT(fr.stats[0].velocity.z(), 0.0);  // element 1 (apex 4, above) moves up
   EXPECT_LT(fr.stats[1].velocity.z(), 0.0);
+  // The crack surface: the facet, debonded and between the two fragments; all
+  // the dissipated energy is in it. Joined again, it is no longer between fragments.
+  const CrackArea a = crack_area(m, t, coh, laws, fr.elem_fragment);
+  EXPECT_CLOSE(a.debonded, area, 1e-15, 0);
+  EXPECT_CLOSE(a.between_fragments, area, 1e-15, 0);
+  EXPECT_CLOSE(a.debonded_dissipated, energy.dissipated, 1e-15, 0);
+  const std::vector<Index> one_piece(m.num_elements(), 0);
+  EXPECT_EQ(crack_area(m, t, coh, laws, one_piece).between_fragments, 0.0);
+  // Freed, the facet exerts no force even when its faces are pushed through
+  // each other (the pieces it separated can fly anywhere), and keeps Gc x area.
+  for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i];
+  for (int j = 0; j < 3; ++j) x[coh.side_nodes[6 + j]] += Vec3(0.3, 0.1, 0.2);
+  std::vector<Vec3> f_free(m.num_nodes(), Vec3::Zero());
+  const CohesiveEnergy e_free = cohesive_forces(m, t, coh, laws, x, f_free);
+  for (const Vec3& fi : f_free) EXPECT_EQ(fi.norm(), 0.0);
+  EXPECT_EQ(e_free.stored, 0.0);
+  EXPECT_CLOSE(e_free.dissipated, expected, 1e-15, 0);
 }
 
 TEST(CohesiveForces, PrescribedMixedOpeningWorkIsGcTimesAreaTet4AndTet10) {
@@ -236,13 +285,8 @@ TEST(CohesiveForces, Tet10UniformOpeningLoadsOnlyMidEdgeNodes) {
 }
 
 TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
-  Mesh m = two_tets();
-  Topology t = build_topology(m);
-  CohesiveElements coh;
-  const CohesiveLaw law = make_cohesive_law(100.0, 1.0, 0.6, 1.0e7);
-  const auto laws = test::one_law(law);
-  const std::vector<Index> facet = {t.elem_facet[3]};  // face 3 of element 0 = (0,2,1)
-  insert_cohesive_elements(m, t, coh, facet);
+  JoinedPair p = joined_pair(two_tets(), 0.6);
+  const Mesh& m = p.m;
   ASSERT_EQ(m.num_nodes(), 8);
   std::vector<Vec3> x = m.reference;
   // A mixed opening with a rotation of side 1, then a compressed one.
@@ -250,7 +294,7 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
     for (Index n = 5; n < 8; ++n)
       x[n] = m.reference[n] + 1e-3 * Vec3(0.3 * n, -0.2, sign * (0.5 + 0.1 * n));
     std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
-    cohesive_forces(m, t, coh, laws, x, f);
+    cohesive_forces(m, p.t, p.coh, p.laws, x, f);
     Vec3 sum = Vec3::Zero();
     double scale = 0;
     for (const Vec3& fi : f) {
@@ -268,45 +312,143 @@ TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
   // rise, in tension and in compression): the largest eigenvalue of
   // M^-1/2 K M^-1/2 stays below cohesive_eigenvalue_bound, which the stable
   // step adds to the elements' omega^2, and the bound is not loose.
-  for (const Mesh& start : {two_tets(), two_tet10s()})
-    for (double beta : {0.6, 1.0, 1.5})
-      for (double sign : {1.0, -1.0}) {
-        Mesh m = start;
-        Topology t = build_topology(m);
-        CohesiveElements coh;
-        const CohesiveLaw law = make_cohesive_law(100.0, 1.0, beta, 1.0e7);
-        const auto laws = test::one_law(law);
-        insert_cohesive_elements(m, t, coh, std::vector<Index>{t.elem_facet[3]});
-        const std::vector<double> mass = test::lumped_masses(m, 1000.0);
-        const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
-        // Open side 1 by a fraction of delta_0 along a mixed direction.
-        std::vector<Vec3> x = m.reference;
-        const int k = m.order == 1 ? 3 : 6;
-        for (int j = 0; j < k; ++j)
-          x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
-        const Index ndof = 3 * m.num_nodes();
-        Eigen::MatrixXd K(ndof, ndof);
-        const double h = 1e-4 * law.delta_0();
-        for (Index d = 0; d < ndof; ++d) {
-          std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
-                            fm(m.num_nodes(), Vec3::Zero());
-          xp[d / 3][d % 3] += h;
-          xm[d / 3][d % 3] -= h;
-          CohesiveElements cp = coh, cm = coh;
-          cohesive_forces(m, t, cp, laws, xp, fp);
-          cohesive_forces(m, t, cm, laws, xm, fm);
-          for (Index r = 0; r < ndof; ++r)
-            K(r, d) = (fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h) /
-                      std::sqrt(mass[r / 3] * mass[d / 3]);
-        }
-        const Eigen::MatrixXd S = 0.5 * (K + K.transpose());
-        const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S)
-                                   .eigenvalues()
-                                   .cwiseAbs()
-                                   .maxCoeff();
-        SCOPED_TRACE(testing::Message() << "order " << m.order << " beta " << beta << " sign "
-                                        << sign << ": largest " << largest << ", bound " << bound);
-        EXPECT_LE(largest, bound * (1 + 1e-6));
-        EXPECT_GE(largest, 0.25 * bound);
+  for_each_joined_pair([](Mesh& m, Topology& t, CohesiveElements& coh, const CohesiveLaw& law,
+                          FractureLaws laws, double sign) {
+    const std::vector<double> mass = test::lumped_masses(m, 1000.0);
+    const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
+    // Open side 1 by a fraction of delta_0 along a mixed direction.
+    std::vector<Vec3> x = m.reference;
+    const int k = m.order == 1 ? 3 : 6;
+    for (int j = 0; j < k; ++j)
+      x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
+    const Index ndof = 3 * m.num_nodes();
+    Eigen::MatrixXd K(ndof, ndof);
+    const double h = 1e-4 * law.delta_0();
+    for (Index d = 0; d < ndof; ++d) {
+      std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
+                        fm(m.num_nodes(), Vec3::Zero());
+      xp[d / 3][d % 3] += h;
+      xm[d / 3][d % 3] -= h;
+      CohesiveElements cp = coh, cm = coh;
+      cohesive_forces(m, t, cp, laws, xp, fp);
+      cohesive_forces(m, t, cm, laws, xm, fm);
+      for (Index r = 0; r < ndof; ++r)
+        K(r, d) =
+            (fp[r / 3][r % 3] - fm[r / 3][r % 3]) / (2 * h) / std::sqrt(mass[r / 3] * mass[d / 3]);
+    }
+    const Eigen::MatrixXd S = 0.5 * (K + K.transpose());
+    const double largest =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S).eigenvalues().cwiseAbs().maxCoeff();
+    SCOPED_TRACE(testing::Message() << "order " << m.order << " beta " << law.beta << " sign "
+                                    << sign << ": largest " << largest << ", bound " << bound);
+    EXPECT_LE(largest, bound * (1 + 1e-6));
+    EXPECT_GE(largest, 0.25 * bound);
+  });
+}
+
+// The nodal forces are the gradient of the cohesive energy at a fixed state,
+// the variation of the current normal included: central differences of the
+// stored energy (unloading, so delta_max stays), for beta != 1, openings in
+// tension and in compression, side 1 turned against side 0. And, the energy
+// being invariant under rotations, they exert no net torque about any point
+// (the term of the normal's variation balances Delta x T).
+TEST(CohesiveForces, ForcesAreTheEnergyGradientAndExertNoTorque) {
+  for_each_joined_pair([](Mesh& m, Topology& t, CohesiveElements& coh, const CohesiveLaw& law,
+                          FractureLaws laws, double sign) {
+    const int k = m.order == 1 ? 3 : 6;
+    std::vector<Vec3> x = m.reference;
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    // Load past the elastic rise (opening 0.5 delta_c, n = -z), then unload to
+    // a turned, less open (sign 1) or closed (sign -1) configuration away
+    // from the origin.
+    for (int j = 0; j < k; ++j) x[coh.side_nodes[6 + j]] += 0.5 * law.delta_c * Vec3(0.6, 0, -0.8);
+    cohesive_forces(m, t, coh, laws, x, f);
+    const Mat3 turn = Eigen::AngleAxisd(0.001, Vec3(0.3, 1, 0.2).normalized()).toRotationMatrix();
+    const Vec3 offset(2.0, -1.0, 0.5);
+    for (Index i = 0; i < m.num_nodes(); ++i) x[i] = m.reference[i] + offset;
+    for (int j = 0; j < k; ++j) {
+      Vec3& xj = x[coh.side_nodes[6 + j]];
+      xj = offset + turn * (xj - offset) + 0.1 * law.delta_c * Vec3(0.5, -0.3, -sign * 0.4);
+    }
+    auto energy = [&](const std::vector<Vec3>& y, std::vector<Vec3>& force) {
+      CohesiveElements state = coh;
+      std::fill(force.begin(), force.end(), Vec3::Zero());
+      const CohesiveEnergy e = cohesive_forces(m, t, state, laws, y, force);
+      EXPECT_EQ(state.delta_max, coh.delta_max) << "the probe reloaded the law";
+      return e.stored;
+    };
+    energy(x, f);
+    double f_scale = 0;
+    Vec3 torque = Vec3::Zero();
+    double torque_scale = 0;
+    for (Index i = 0; i < m.num_nodes(); ++i) {
+      f_scale = std::max(f_scale, f[i].norm());
+      torque += x[i].cross(f[i]);
+      torque_scale += x[i].norm() * f[i].norm();
+    }
+    SCOPED_TRACE(testing::Message()
+                 << "order " << m.order << " beta " << law.beta << " sign " << sign);
+    ASSERT_GT(f_scale, 0.0);
+    EXPECT_LT(torque.norm(), 1e-14 * torque_scale);
+    const double h = 1e-7;
+    std::vector<Vec3> scratch(m.num_nodes());
+    double err = 0;
+    for (Index i = 0; i < m.num_nodes(); ++i)
+      for (int d = 0; d < 3; ++d) {
+        std::vector<Vec3> xp = x, xm = x;
+        xp[i][d] += h;
+        xm[i][d] -= h;
+        const double fd = (energy(xp, scratch) - energy(xm, scratch)) / (2 * h);
+        err = std::max(err, std::abs(fd - f[i][d]));
       }
+    EXPECT_LT(err, 1e-6 * f_scale);
+  });
+}
+
+// A facet slid past delta_c while pressed shut is not freed: its compression
+// penalty holds energy that would vanish from the ledger with it. Opened, it is.
+TEST(CohesiveForces, DebondedFacetIsFreedOnlyOutOfCompression) {
+  JoinedPair p = joined_pair(two_tets(), 1.0);
+  const Mesh& m = p.m;
+  Topology& t = p.t;
+  CohesiveElements& coh = p.coh;
+  const CohesiveLaw& law = p.law;
+  const FractureLaws laws = p.laws;
+  const Index facet = p.coh.facet[0];
+  // n = -z (from element 0 above to element 1 below): +z on side 1 presses it shut.
+  for (double dz : {0.1, -0.1}) {
+    std::vector<Vec3> x = m.reference;
+    for (int j = 0; j < 3; ++j) x[coh.side_nodes[6 + j]] += law.delta_c * Vec3(1.5, 0, dz);
+    std::vector<Vec3> f(m.num_nodes(), Vec3::Zero());
+    const CohesiveEnergy e = cohesive_forces(m, t, coh, laws, x, f);
+    EXPECT_CLOSE(e.dissipated, law.fracture_energy() * 0.5, 1e-14, 0);
+    if (dz > 0) {
+      EXPECT_GT(e.stored, 0.0);
+      EXPECT_EQ(release_debonded(m, t, coh, laws, x), 0);
+      EXPECT_EQ(t.facet_state[facet], FacetState::cohesive);
+    } else {
+      EXPECT_EQ(e.stored, 0.0);
+      EXPECT_EQ(release_debonded(m, t, coh, laws, x), 1);
+      EXPECT_EQ(t.facet_state[facet], FacetState::free);
+    }
+  }
+}
+
+// Side 1 turned half a turn about the facet's centroid: the mid-surface collapses to
+// a point and has no normal. The forces stay finite (and balanced).
+TEST(CohesiveForces, CollapsedMidSurfaceGivesFiniteForces) {
+  JoinedPair p = joined_pair(two_tets(), 1.0);
+  std::vector<Vec3> x = p.m.reference;
+  Vec3 centre = Vec3::Zero();
+  for (int j = 0; j < 3; ++j) centre += x[p.coh.side_nodes[j]] / 3;
+  for (int j = 0; j < 3; ++j) x[p.coh.side_nodes[6 + j]] = 2 * centre - x[p.coh.side_nodes[j]];
+  std::vector<Vec3> f(p.m.num_nodes(), Vec3::Zero());
+  const CohesiveEnergy e = cohesive_forces(p.m, p.t, p.coh, p.laws, x, f);
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& fi : f) {
+    EXPECT_TRUE(fi.allFinite());
+    sum += fi;
+  }
+  EXPECT_TRUE(std::isfinite(e.stored));
+  EXPECT_LT(sum.norm(), 1e-12);
 }

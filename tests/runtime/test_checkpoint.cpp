@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -265,6 +266,26 @@ TEST(Checkpoint, RestoredContactRunIsBitwiseTheUninterruptedOne) {
   EXPECT_GT(contacts, 0) << "the scene must be in contact after the checkpoint";
 }
 
+// The step controller's state (StepControl: the step held, its window) is part
+// of the checkpoint, so a restarted run changes its step where the uninterrupted
+// one does.
+TEST(Checkpoint, StepControllerStateIsKept) {
+  const std::string yaml = free_scene("ckpt_control");
+  Model model = build_model(scene_from_text("ckpt_control", yaml));
+  Simulation sim(model, {});
+  for (int s = 0; s < 7; ++s) sim.step();
+  SimulationState state;
+  sim.save_state(state);
+  ASSERT_GT(state.step_control.window_steps, 0);
+  ASSERT_TRUE(std::isfinite(state.step_control.window_min));
+  const fs::path file = test_dir("control") / "checkpoint.h5";
+  write_checkpoint(file, model, state);
+  const SimulationState back = read_checkpoint(file, model);
+  EXPECT_EQ(back.step_control.dt, state.step_control.dt);
+  EXPECT_EQ(back.step_control.window_min, state.step_control.window_min);
+  EXPECT_EQ(back.step_control.window_steps, state.step_control.window_steps);
+}
+
 TEST(Checkpoint, TruncatedFileIsRefused) {
   const fs::path dir = test_dir("truncated");
   const fs::path good = dir / "checkpoint.h5", cut = dir / "cut.h5";
@@ -317,6 +338,9 @@ TEST(Checkpoint, CorruptedBytesAreRefusedOrHarmless) {
       EXPECT_EQ(s.time, ref.time) << "byte " << at;
       EXPECT_EQ(s.dt, ref.dt) << "byte " << at;
       EXPECT_EQ(s.stable_dt, ref.stable_dt) << "byte " << at;
+      EXPECT_EQ(s.step_control.dt, ref.step_control.dt) << "byte " << at;
+      EXPECT_EQ(s.step_control.window_min, ref.step_control.window_min) << "byte " << at;
+      EXPECT_EQ(s.step_control.window_steps, ref.step_control.window_steps) << "byte " << at;
       EXPECT_EQ(s.ledger.kinetic, ref.ledger.kinetic) << "byte " << at;
       EXPECT_EQ(s.ledger.external_work, ref.ledger.external_work) << "byte " << at;
       EXPECT_TRUE(bitwise_equal(s.x, ref.x) && bitwise_equal(s.v, ref.v) &&
