@@ -424,11 +424,17 @@ void Simulation::save_state(SimulationState& s) const {
   s.dt = dt_;
   s.stable_dt = stable_dt_;
   s.step_control = step_control_;
-  s.x = x_;
-  s.v = v_;
-  s.a = a_;
-  s.f_int = f_int_;
-  s.f_ext = f_ext_;
+  // Every step saves the state before it (the last good state of a failure): only the nodes
+  // this rank touches, in parallel; a checkpoint takes each node from its owner.
+  const Index n = model_.mesh.num_nodes();
+  for (auto* a : {&s.x, &s.v, &s.a, &s.f_int, &s.f_ext}) a->resize(n);
+  dec_->for_touched(n, [&](Index i) {
+    s.x[i] = x_[i];
+    s.v[i] = v_[i];
+    s.a[i] = a_[i];
+    s.f_int[i] = f_int_[i];
+    s.f_ext[i] = f_ext_[i];
+  });
   s.reaction = reaction_;
   s.ledger = ledger_;
   s.total0 = total0_;
