@@ -4,7 +4,7 @@
 #
 #   bench/mpi_scaling.sh BUILD strong [ELEMENTS] [REPEATS]
 #       ranks x threads = 1x1, 1x2, 2x1 on ELEMENTS tets (default 500000),
-#       REPEATS runs each (default 3), medians of the loop wall time.
+#       REPEATS runs each (default 5), interleaved; medians of the loop wall time.
 #   bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
 #       R = 1, 2, 4, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
 #       tets per rank (default 2000), to 2e-4 s (the boxes meet after 5e-5 s):
@@ -17,9 +17,12 @@ build=${1:?usage: mpi_scaling.sh BUILD strong|weak ...}
 mode=${2:?strong or weak}
 here=$(cd "$(dirname "$0")" && pwd)
 shatter="$build/apps/shatter"
-# --bind-to none: Open MPI binds each rank to one core when there are at most 2 ranks,
-# which would put all threads of a 1 x 2 run on one core (measured: 1.05x instead of 1.64x).
-mpi=(mpirun --allow-run-as-root --oversubscribe --bind-to none)
+# Binding: a rank of one thread is bound to a core (--bind-to core): left free, the
+# single thread of a 1 x 1 run wanders between this VM's two vCPUs and its element
+# loop took 10-12.7 s instead of 10.1 s (measured). A rank of several threads is
+# not bound (--bind-to none), or all its threads would share one core (1.05x).
+mpi=(mpirun --allow-run-as-root --oversubscribe)
+bind() { if [ "$1" -gt 1 ]; then echo none; else echo core; fi; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$here/results"
@@ -51,21 +54,34 @@ key() { grep -o "\"$2\": [-0-9.e+]*" "$1/summary.json" | awk '{print $2}'; }
 
 if [ "$mode" = strong ]; then
   elements=${3:-500000}
-  repeats=${4:-3}
+  repeats=${4:-5}
   h=$(size_for "$elements")
   out="$here/results/mpi_scaling_strong.csv"
-  echo "ranks,threads,elements,steps,wall_median,element_loop,contact_search,contact_dcr,communication,load" > "$out"
-  for rt in "1 1" "1 2" "2 1"; do
+  echo "ranks,threads,elements,steps,wall_median,wall_min,wall_max,element_loop,contact_search,contact_dcr,communication" > "$out"
+  # The runs are interleaved (1x1, 1x2, 2x1, 1x1, ...) so that a slow spell of a
+  # shared machine falls on every configuration alike, not on one.
+  configs=("1 1" "1 2" "2 1")
+  declare -A walls
+  for k in $(seq 1 "$repeats"); do
+    for rt in "${configs[@]}"; do
+      set -- $rt
+      dir="$work/r$1t$2_$k"
+      "${mpi[@]}" --bind-to "$(bind "$2")" -n "$1" "$shatter" run "$scene" --out "$dir" --threads "$2" --quiet \
+        --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
+      walls[$1x$2]+="$(key "$dir" wall_time) "
+      echo "run $k: ${1}x$2 $(key "$dir" wall_time) s (load $(cut -d' ' -f1 /proc/loadavg))" >&2
+    done
+  done
+  for rt in "${configs[@]}"; do
     set -- $rt
-    walls=()
+    # The run whose wall time is the median gives the split of its step.
+    stats=$(printf '%s\n' ${walls[$1x$2]} | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)], a[1], a[NR]}')
+    read -r median lo hi <<< "$stats"
     for k in $(seq 1 "$repeats"); do
       dir="$work/r$1t$2_$k"
-      "${mpi[@]}" -n "$1" "$shatter" run "$scene" --out "$dir" --threads "$2" --quiet \
-        --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
-      walls+=("$(key "$dir" wall_time)")
+      [ "$(key "$dir" wall_time)" = "$median" ] && break
     done
-    median=$(printf '%s\n' "${walls[@]}" | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
-    echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time),$(cut -d' ' -f1 /proc/loadavg)" | tee -a "$out"
+    echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$lo,$hi,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time)" | tee -a "$out"
   done
 else
   per_rank=${3:-2000}
@@ -76,7 +92,7 @@ else
   while [ "$r" -le "$max_ranks" ]; do
     h=$(size_for $((per_rank * r)))
     dir="$work/weak$r"
-    "${mpi[@]}" -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
+    "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
       --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
     echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" granule_sum_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(key "$dir" peak_memory_bytes)" | tee -a "$out"
     r=$((r * 2))
