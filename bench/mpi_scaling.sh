@@ -17,10 +17,11 @@ build=${1:?usage: mpi_scaling.sh BUILD strong|weak ...}
 mode=${2:?strong or weak}
 here=$(cd "$(dirname "$0")" && pwd)
 shatter="$build/apps/shatter"
-# Binding: a rank of one thread is bound to a core (--bind-to core): left free, the
-# single thread of a 1 x 1 run wanders between this VM's two vCPUs and its element
-# loop took 10-12.7 s instead of 10.1 s (measured). A rank of several threads is
-# not bound (--bind-to none), or all its threads would share one core (1.05x).
+# Binding (strong runs): a rank of one thread is bound to a core (--bind-to core):
+# left free, the single thread of a 1 x 1 run wanders between this VM's two vCPUs
+# and its element loop took 10-12.7 s instead of 10.1 s (measured). A rank of
+# several threads is not bound (--bind-to none), or all its threads would share
+# one core (1.05x). The weak runs are oversubscribed and not bound.
 mpi=(mpirun --allow-run-as-root --oversubscribe)
 bind() { if [ "$1" -gt 1 ]; then echo none; else echo core; fi; }
 work=$(mktemp -d)
@@ -61,26 +62,23 @@ if [ "$mode" = strong ]; then
   # The runs are interleaved (1x1, 1x2, 2x1, 1x1, ...) so that a slow spell of a
   # shared machine falls on every configuration alike, not on one.
   configs=("1 1" "1 2" "2 1")
-  declare -A walls
+  declare -A runs  # per configuration, one "wall_time run_dir" line per run
   for k in $(seq 1 "$repeats"); do
     for rt in "${configs[@]}"; do
       set -- $rt
       dir="$work/r$1t$2_$k"
       "${mpi[@]}" --bind-to "$(bind "$2")" -n "$1" "$shatter" run "$scene" --out "$dir" --threads "$2" --quiet \
         --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
-      walls[$1x$2]+="$(key "$dir" wall_time) "
-      echo "run $k: ${1}x$2 $(key "$dir" wall_time) s (load $(cut -d' ' -f1 /proc/loadavg))" >&2
+      wall=$(key "$dir" wall_time)
+      runs[$1x$2]+="$wall $dir"$'\n'
+      echo "run $k: ${1}x$2 $wall s (load $(cut -d' ' -f1 /proc/loadavg))" >&2
     done
   done
   for rt in "${configs[@]}"; do
     set -- $rt
-    # The run whose wall time is the median gives the split of its step.
-    stats=$(printf '%s\n' ${walls[$1x$2]} | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)], a[1], a[NR]}')
-    read -r median lo hi <<< "$stats"
-    for k in $(seq 1 "$repeats"); do
-      dir="$work/r$1t$2_$k"
-      [ "$(key "$dir" wall_time)" = "$median" ] && break
-    done
+    # Median, min and max wall time; the median run gives the split of its step.
+    read -r median dir lo hi <<< "$(printf '%s' "${runs[$1x$2]}" | sort -g |
+      awk '{w[NR] = $1; d[NR] = $2} END {m = int((NR + 1) / 2); print w[m], d[m], w[1], w[NR]}')"
     echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$lo,$hi,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time)" | tee -a "$out"
   done
 else
