@@ -22,7 +22,9 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/failure.hpp"
 #include "runtime/model.hpp"
+#include "runtime/output_folder.hpp"
 #include "runtime/report.hpp"
+#include "runtime/restart_check.hpp"
 #include "runtime/scene.hpp"
 #include "runtime/simulation.hpp"
 
@@ -142,7 +144,6 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (*plot) return rank == 0 ? plot_outputs(out_dir) : 0;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     const Scene scene = load_scene(scene_path, overrides);
-    model = build_model(scene);
     RunOptions opt;
     opt.threads = threads;
     opt.ranks = ranks;
@@ -155,8 +156,17 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
     // A restart continues the outputs beside its checkpoint unless --out says otherwise.
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
+    // Before the meshing: a folder that cannot take the outputs is bad input.
+    if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
+    model = build_model(scene);
     sim = std::make_unique<Simulation>(*model, opt);
-    if (!restart.empty()) sim->restore_state(read_checkpoint(restart, *model));
+    if (!restart.empty()) {
+      CheckpointRun written;
+      SimulationState state = read_checkpoint(restart, *model, &written);
+      // Before run() cuts the rows after the checkpoint: a refused restart touches nothing.
+      on_root_for_all(MPI_COMM_WORLD, [&] { check_restart(restart, state, written, scene, opt.out_dir); });
+      sim->restore_state(state);
+    }
     if (*check) {
       print_check(*model, *sim);
     } else {

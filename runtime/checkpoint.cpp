@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/scene_keys.hpp"
 
 namespace shatter {
 namespace {
@@ -18,7 +19,8 @@ namespace {
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
 
 constexpr const char* kFormat = "shatter-checkpoint";
-constexpr long kVersion = 2;  // 2: the step controller's state
+constexpr long kVersion = 3;  // 2: the step controller's state; 3: the scene's physics keys
+constexpr long kOldestVersion = 2;  // read without the physics check
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -279,6 +281,11 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.number(root, "total0", s.total0);
     w.number(root, "energy_scale", s.energy_scale);
     w.text(root, "failure", failure);
+    const std::string physics = physics_keys(model.scene);
+    const std::uint64_t scene_fp = fnv1a(physics.data(), physics.size());
+    w.text(root, "physics", physics);
+    w.attribute(root, "scene_fingerprint", H5T_NATIVE_UINT64, &scene_fp);
+    w.integer(root, "history_every", model.scene.history_every);
 
     H5Handle state(H5Gcreate2(root, "state", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     w.check(state.valid(), "create group /state");
@@ -348,7 +355,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
   sync_path(dir, O_RDONLY | O_DIRECTORY);
 }
 
-SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model) {
+SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model, CheckpointRun* run) {
   const Reader r{path.string()};
   r.require(std::filesystem::is_regular_file(path), "no such file");
   const QuietHdf5 quiet;
@@ -364,12 +371,26 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   r.require(root_group.valid(), "cannot open the root group (truncated or corrupted checkpoint?)");
   const hid_t root = root_group.get();
   r.require(r.text(root, "format") == kFormat, "not a shatter checkpoint");
-  r.require(r.integer(root, "version") == kVersion,
-            "checkpoint format version " + std::to_string(r.integer(root, "version")) +
-                ", this shatter reads " + std::to_string(kVersion));
+  const long version = r.integer(root, "version");
+  r.require(version >= kOldestVersion && version <= kVersion,
+            "checkpoint format version " + std::to_string(version) + ", this shatter reads " +
+                std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
   const std::string scene = r.text(root, "scene");
   r.require(scene == model.scene.name, "the checkpoint is of scene '" + scene + "', not of '" +
                                            model.scene.name + "' (" + model.scene.file + ")");
+  if (version >= 3) {
+    const std::string physics = r.text(root, "physics");
+    std::uint64_t scene_fp = 0;
+    r.attribute(root, "scene_fingerprint", H5T_NATIVE_UINT64, &scene_fp);
+    r.require(scene_fp == fnv1a(physics.data(), physics.size()),
+              "attribute physics fails its hash check (corrupted checkpoint)");
+    const KeyDifference d = first_difference(physics, physics_keys(model.scene));
+    r.require(d.key.empty(), d.key + " is " + d.a + " in the checkpoint's scene and " + d.b + " in " +
+                                 model.scene.file +
+                                 "; expected the physics of the checkpoint's run (a restart may "
+                                 "change only time.end, time.safety, time.dt, output and checkpoint)");
+    if (run) run->history_every = r.integer(root, "history_every");
+  }
   const long nodes = r.integer(root, "nodes"), elements = r.integer(root, "elements"),
              order = r.integer(root, "order");
   if (nodes != model.mesh.num_nodes() || elements != model.mesh.num_elements() ||
