@@ -21,6 +21,7 @@
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/failure.hpp"
+#include "runtime/disk_reserve.hpp"
 #include "runtime/model.hpp"
 #include "runtime/output_folder.hpp"
 #include "runtime/report.hpp"
@@ -194,6 +195,7 @@ int main(int argc, char** argv) {
     FailureChannel failures(MPI_COMM_WORLD);
     status = cli(argc, argv, failures);
   }
+  release_disk_space();
   MPI_Finalize();
   return status;
 }

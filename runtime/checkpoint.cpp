@@ -5,12 +5,14 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/hdf5_failure.hpp"
 #include "runtime/scene_keys.hpp"
 
 namespace shatter {
@@ -46,21 +48,6 @@ class H5Handle {
  private:
   hid_t id_;
   herr_t (*close_)(hid_t);
-};
-
-/// Silences HDF5's error stack printing while alive: failures are reported
-/// by our own messages.
-class QuietHdf5 {
- public:
-  QuietHdf5() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
 };
 
 /// HDF5 types of the arrays a checkpoint holds: file() as stored
@@ -110,9 +97,10 @@ static_assert(sizeof(FacetState) == 1);
 struct Writer {
   std::string path;
   void check(bool ok, const std::string& what) const {
-    SHATTER_REQUIRE(ok, "checkpoint " << path << ": HDF5 failed to " << what);
+    SHATTER_REQUIRE(ok, "checkpoint " << path << ": " << hdf5_write_failure(what));
   }
   void attribute(hid_t object, const char* name, hid_t type, const void* value) const {
+    errno = 0;  // hdf5_write_failure reports the OS's reason of a failure in here
     H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
     H5Handle attr(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     check(space.valid() && attr.valid() && H5Awrite(attr.get(), type, value) >= 0,
@@ -137,6 +125,7 @@ struct Writer {
     const hsize_t numbers = a.size() * FileType<T>::numbers;
     SHATTER_REQUIRE(numbers % cols == 0, "checkpoint: dataset " << name << " is not a whole number of rows");
     const std::array<hsize_t, 2> dims{numbers / cols, cols};
+    errno = 0;
     H5Handle space(H5Screate_simple(2, dims.data(), nullptr), H5Sclose);
     H5Handle dset(
         H5Dcreate2(group, name, FileType<T>::file(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
@@ -230,6 +219,24 @@ struct Reader {
   }
 };
 
+template <class... Arrays>
+std::uintmax_t bytes_of(const Arrays&... a) {
+  return ((a.size() * sizeof(typename Arrays::value_type)) + ...);
+}
+
+/// The bytes of the arrays a checkpoint of `s` holds (its metadata aside).
+std::uintmax_t checkpoint_bytes(const SimulationState& s) {
+  std::uintmax_t bytes = bytes_of(s.x, s.v, s.a, s.f_int, s.f_ext, s.reaction);
+  if (s.fracture) {
+    const FractureState& f = *s.fracture;
+    const CohesiveElements& c = f.cohesive;
+    bytes += bytes_of(f.reference, f.node_gid, f.node_body, f.conn, f.mass, f.bc_mask, f.bc_velocity,
+                      f.initial_velocity, f.facet_state, c.facet, c.side_local, c.side_nodes, c.area, c.normal,
+                      c.delta_max);
+  }
+  return bytes;
+}
+
 volatile std::sig_atomic_t g_stop_signal = 0;
 
 void record_stop_signal(int sig) {
@@ -253,12 +260,15 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
   const std::filesystem::path tmp = path.string() + ".tmp";
   const Writer w{tmp.string()};
   const QuietHdf5 quiet;
-  {
+  const std::string lacking = lacking_space(tmp.parent_path(), checkpoint_bytes(s));
+  SHATTER_REQUIRE(lacking.empty(), "checkpoint " << tmp.string() << ": not written: " << lacking);
+  try {
     H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
     // Version 2 object headers and superblock: HDF5 checksums all metadata.
     w.check(
         fapl.valid() && H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST) >= 0,
         "select the latest file format");
+    errno = 0;
     H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
     w.check(file.valid(), "create the file");
     H5Handle root_group(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose);
@@ -343,8 +353,16 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       w.rows(fr, "cohesive_normal", c.normal);
       w.array(fr, "cohesive_delta_max", c.delta_max, kCohesivePoints);
     }
+    errno = 0;
     w.check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL) >= 0, "flush the file");
-  }  // closed here: everything is in the OS's hands
+    // Closed here (the handles above): everything is in the OS's hands.
+  } catch (const Error&) {
+    // The half-written file is of no use, and its space lets the other
+    // files close on a full disk (disk_reserve.hpp).
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
   sync_path(tmp, O_RDONLY);
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);

@@ -1,12 +1,7 @@
 #include "runtime/output_folder.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-
 #include "kernels/error.hpp"
+#include "runtime/disk_reserve.hpp"
 
 namespace shatter {
 
@@ -27,11 +22,13 @@ void on_root_for_all(MPI_Comm comm, const std::function<void()>& check) {
   throw InputError(error);
 }
 
-void refuse_folder_at(const std::filesystem::path& file) {
+void refuse_non_file_at(const std::filesystem::path& file) {
   std::error_code ec;
-  if (std::filesystem::is_directory(file, ec))
-    throw InputError("output folder " + file.parent_path().string() + ": " + file.string() +
-                     " is a folder; expected a file the run can replace, or nothing");
+  const std::filesystem::file_status st = std::filesystem::status(file, ec);  // through links
+  if (!std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return;
+  const std::string what = std::filesystem::is_directory(st) ? "a folder" : "not a regular file (a device or a pipe)";
+  throw InputError("output folder " + file.parent_path().string() + ": " + file.string() + " is " + what +
+                   "; expected a file the run can replace, or nothing");
 }
 
 void prepare_output_folder(const std::filesystem::path& dir, MPI_Comm comm) {
@@ -42,21 +39,13 @@ void prepare_output_folder(const std::filesystem::path& dir, MPI_Comm comm) {
     if (ec) throw InputError(where + ": cannot create it (" + ec.message() + ")");
     if (!std::filesystem::is_directory(dir, ec))
       throw InputError(where + ": it exists and is not a folder");
-    // A file written and removed: a read-only or full file system is found
-    // here, with the OS's reason, rather than by the first output of the run.
-    const std::filesystem::path probe = dir / ".shatter_write_probe";
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    int err = fd < 0 ? errno : 0;
-    if (fd >= 0) {
-      const char byte = 0;
-      if (::write(fd, &byte, 1) != 1 || ::fsync(fd) != 0) err = errno;
-      if (::close(fd) != 0 && err == 0) err = errno;
-      ::unlink(probe.c_str());
-    }
-    if (err != 0) throw InputError(where + ": cannot write in it (" + std::strerror(err) + ")");
+    // The disk reserve (hdf5_failure.hpp), written now: a read-only or full
+    // file system is found here, with the OS's reason, not by an output.
+    const std::string reason = reserve_disk_space(dir);
+    if (!reason.empty()) throw InputError(where + ": cannot write in it (" + reason + ")");
     for (const char* name : {"history.csv", "bodies.csv", "fields.h5", "fields.xdmf", "summary.json",
                              "fragments.csv", "checkpoint.h5", "checkpoint.h5.tmp"})
-      refuse_folder_at(dir / name);
+      refuse_non_file_at(dir / name);
   });
 }
 

@@ -19,7 +19,7 @@ namespace shatter {
 ///    at or before the checkpoint's step (a row every `run.history_every`
 ///    steps, the scene's when the checkpoint does not record it): the rows in
 ///    between are lost and the continued file would have a gap;
-///  - `out_dir`/restart_<step>/fields.h5 or fields.xdmf is a folder.
+///  - `out_dir`/restart_<step>/fields.h5 or fields.xdmf is a folder or a device.
 void check_restart(const std::filesystem::path& checkpoint, const SimulationState& state,
                    const CheckpointRun& run, const Scene& scene, const std::filesystem::path& out_dir);
 
