@@ -27,6 +27,7 @@
 #include "runtime/report.hpp"
 #include "runtime/restart_check.hpp"
 #include "runtime/scene.hpp"
+#include "runtime/setup_stop.hpp"
 #include "runtime/simulation.hpp"
 
 using namespace shatter;
@@ -188,8 +189,13 @@ int cli(int argc, char** argv, FailureChannel& failures) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_setup_stop_handlers();
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  set_setup_stop_rank(rank);
+  install_setup_stop_handlers();
   int status = 0;
   {
     FailureChannel failures(MPI_COMM_WORLD);
