@@ -33,6 +33,18 @@ std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 14695
   return h;
 }
 
+/// A hash of every attribute of a checkpoint (names and values; a dataset's
+/// own hash of its bytes is one of them), summed so that the order of
+/// writing and reading does not matter. Stored as the root attribute
+/// state_fnv1a64: a file spliced from two checkpoints, each part intact in
+/// itself (datasets pass their own hashes), fails it.
+struct StateDigest {
+  std::uint64_t sum = 0;
+  void add(const char* name, const void* value, std::size_t bytes) {
+    sum += fnv1a(value, bytes, fnv1a(name, std::strlen(name)));
+  }
+};
+
 /// Owns one HDF5 identifier and closes it with the matching H5?close.
 class H5Handle {
  public:
@@ -96,6 +108,7 @@ static_assert(sizeof(FacetState) == 1);
 
 struct Writer {
   std::string path;
+  mutable StateDigest digest;
   void check(bool ok, const std::string& what) const {
     SHATTER_REQUIRE(ok, "checkpoint " << path << ": " << hdf5_write_failure(what));
   }
@@ -105,6 +118,7 @@ struct Writer {
     H5Handle attr(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     check(space.valid() && attr.valid() && H5Awrite(attr.get(), type, value) >= 0,
           std::string("write attribute ") + name);
+    digest.add(name, value, H5Tget_size(type));
   }
   void number(hid_t object, const char* name, double v) const {
     attribute(object, name, H5T_NATIVE_DOUBLE, &v);
@@ -155,6 +169,7 @@ void sync_path(const std::filesystem::path& p, int flags) {
 
 struct Reader {
   std::string path;
+  mutable StateDigest digest;
   [[noreturn]] void fail(const std::string& why) const {
     throw InputError("--restart " + path + ": " + why);
   }
@@ -166,6 +181,7 @@ struct Reader {
     require(attr.valid() && H5Aread(attr.get(), type, value) >= 0,
             std::string("attribute ") + name +
                 " is missing or unreadable (truncated or corrupted checkpoint?)");
+    digest.add(name, value, H5Tget_size(type));
   }
   double number(hid_t object, const char* name) const {
     double v = 0;
@@ -188,6 +204,7 @@ struct Reader {
     std::string s(H5Tget_size(type.get()), '\0');
     require(H5Aread(attr.get(), type.get(), s.data()) >= 0,
             std::string("cannot read attribute ") + name);
+    digest.add(name, s.data(), s.size());
     return s.c_str();
   }
   /// Reads a dataset written by Writer::array: `expected` rows of `cols`
@@ -258,7 +275,7 @@ std::uint64_t model_fingerprint(const Model& model) {
 void write_checkpoint(const std::filesystem::path& path, const Model& model,
                       const SimulationState& s, const std::string& failure) {
   const std::filesystem::path tmp = path.string() + ".tmp";
-  const Writer w{tmp.string()};
+  const Writer w{tmp.string(), {}};
   const QuietHdf5 quiet;
   const std::string lacking = lacking_space(tmp.parent_path(), checkpoint_bytes(s));
   SHATTER_REQUIRE(lacking.empty(), "checkpoint " << tmp.string() << ": not written: " << lacking);
@@ -353,6 +370,9 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       w.rows(fr, "cohesive_normal", c.normal);
       w.array(fr, "cohesive_delta_max", c.delta_max, kCohesivePoints);
     }
+    // Last: the sum of everything written above (not itself part of it).
+    const std::uint64_t whole = w.digest.sum;
+    w.attribute(root, "state_fnv1a64", H5T_NATIVE_UINT64, &whole);
     errno = 0;
     w.check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL) >= 0, "flush the file");
     // Closed here (the handles above): everything is in the OS's hands.
@@ -374,7 +394,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 }
 
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model, CheckpointRun* run) {
-  const Reader r{path.string()};
+  const Reader r{path.string(), {}};
   r.require(std::filesystem::is_regular_file(path), "no such file");
   const QuietHdf5 quiet;
   r.require(H5Fis_hdf5(path.c_str()) > 0,
@@ -407,7 +427,8 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
                                  model.scene.file +
                                  "; expected the physics of the checkpoint's run (a restart may "
                                  "change only time.end, time.safety, time.dt, output and checkpoint)");
-    if (run) run->history_every = r.integer(root, "history_every");
+    const long history_every = r.integer(root, "history_every");
+    if (run) run->history_every = history_every;
   }
   const long nodes = r.integer(root, "nodes"), elements = r.integer(root, "elements"),
              order = r.integer(root, "order");
@@ -505,6 +526,15 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   l.cohesive_elements = r.integer(g, "cohesive_elements");
   l.fragments = r.integer(g, "fragments");
   l.contact_capped_steps = r.integer(g, "contact_capped_steps");
+  if (version >= 3) {
+    r.text(root, "failure");  // read for the digest: every attribute written is read
+    const std::uint64_t sum = r.digest.sum;
+    std::uint64_t whole = 0;
+    r.attribute(root, "state_fnv1a64", H5T_NATIVE_UINT64, &whole);
+    r.require(whole == sum,
+              "the parts of the file do not belong together (spliced from different checkpoints, or "
+              "corrupted): the whole-file hash state_fnv1a64 fails");
+  }
   return s;
 }
 

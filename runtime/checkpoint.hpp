@@ -33,6 +33,11 @@
 //       scene_fingerprint  uint64: FNV-1a of the physics text
 //       history_every int64: output.history_every of the run, by which a
 //                     restart knows which rows history.csv must hold
+//       state_fnv1a64 uint64, written last: the sum over every other
+//                     attribute of the file (all groups, the datasets'
+//                     fnv1a64 included) of FNV-1a(name, value); a file spliced
+//                     from two checkpoints, each part passing its own hashes,
+//                     fails it
 //   /state/positions, velocities, accelerations, internal_forces,
 //          external_forces      n x 3 float64 (m, m/s, m/s^2, N, N)
 //   /state/reactions            b x 3 float64, N

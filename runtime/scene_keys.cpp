@@ -99,6 +99,7 @@ std::string physics_keys(const Scene& s) {
         w.text(key, "null");
     }
   }
+  w.text("contact", s.contact ? "on" : "off");
   if (s.contact) {
     const ContactSpec& c = *s.contact;
     w.number("contact.friction", c.friction);
@@ -108,8 +109,6 @@ std::string physics_keys(const Scene& s) {
     const DcrPlacement p = c.placement;
     w.text("contact.placement", p == DcrPlacement::End ? "end" : p == DcrPlacement::Middle ? "middle" : "impact");
     w.text("contact.on_sweep_cap", c.sweep_cap_fatal ? "fail" : "warn");
-  } else {
-    w.text("contact", "null");
   }
   w.vec3("gravity", s.gravity);
   return w.str();
