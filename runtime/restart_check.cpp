@@ -55,7 +55,7 @@ void check_restart(const std::filesystem::path& checkpoint, const SimulationStat
                        std::to_string(needed) + " (the run's own " + name + ")");
   }
   const std::filesystem::path fields = out_dir / ("restart_" + std::to_string(state.step));
-  for (const char* name : {"fields.h5", "fields.xdmf"}) refuse_non_file_at(fields / name);
+  for (const char* name : {"fields.h5", "fields.xdmf"}) refuse_non_file_at(fields / name, true);
 }
 
 }  // namespace shatter

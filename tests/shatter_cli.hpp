@@ -2,7 +2,11 @@
 // The shatter binary run from a test: exit status and output, and files
 // read whole, so that a test can check what a command printed and that the
 // files it must not touch are byte for byte as they were.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -10,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace shatter::test {
 
@@ -29,6 +34,37 @@ inline CliOutcome run_shatter(const std::string& args) {
   const int st = pclose(p);
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
+}
+
+/// A shatter process started in the background (start_shatter).
+struct Child {
+  pid_t pid = -1;
+  std::filesystem::path log;
+};
+
+/// Starts the shatter binary with `args`, stdout and stderr to `log`.
+inline Child start_shatter(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  std::vector<std::string> argv{std::string(SHATTER_BINARY_DIR) + "/apps/shatter"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  Child c;
+  c.log = log;
+  EXPECT_EQ(posix_spawn(&c.pid, cargv[0], &actions, nullptr, cargv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  return c;
+}
+
+/// Waits for the child; returns its exit status (-1 when ended by a signal).
+inline int finish(const Child& c) {
+  int st = 0;
+  EXPECT_EQ(waitpid(c.pid, &st, 0), c.pid);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 /// The bytes of a file ("" when it cannot be read).

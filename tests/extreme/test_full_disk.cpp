@@ -22,15 +22,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string kScene =
-    "name: full_disk\n"
-    "time: {end: 1.0e-6}\n"
-    "materials:\n"
-    "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-    "bodies:\n"
-    "  - name: b\n"
-    "    material: steel\n"
-    "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.0012}\n"
-    "checkpoint: {every_steps: 3}\n";
+    shatter::test::steel_box_scene("full_disk", "0.0012", "", "checkpoint: {every_steps: 3}\n");
 
 }  // namespace
 

@@ -31,8 +31,12 @@
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
 #include "scene_text.hpp"
+#include "shatter_cli.hpp"
 
 using namespace shatter;
+using shatter::test::Child;
+using shatter::test::finish;
+using shatter::test::start_shatter;
 using shatter::test::scene_from_text;
 using shatter::test::write_scene;
 namespace fs = std::filesystem;
@@ -214,36 +218,6 @@ std::string slurp(const fs::path& p) {
   std::ostringstream os;
   os << in.rdbuf();
   return os.str();
-}
-
-struct Child {
-  pid_t pid = -1;
-  fs::path log;
-};
-
-/// Starts the shatter binary with `args`, stdout and stderr to `log`.
-Child start_shatter(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv{std::string(SHATTER_BINARY_DIR) + "/apps/shatter"};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> cargv;
-  for (auto& a : argv) cargv.push_back(a.data());
-  cargv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  Child c;
-  c.log = log;
-  EXPECT_EQ(posix_spawn(&c.pid, cargv[0], &actions, nullptr, cargv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
-  return c;
-}
-
-/// Waits for the child; returns its exit status (-1 when killed by a signal).
-int finish(const Child& c) {
-  int st = 0;
-  EXPECT_EQ(waitpid(c.pid, &st, 0), c.pid);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 long count_lines(const fs::path& p) {

@@ -5,6 +5,7 @@
 // and files spliced from two checkpoints of the same run.
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <unistd.h>
 
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
@@ -21,17 +22,8 @@ using shatter::test::scratch_dir;
 
 namespace {
 
-const std::string kScene =
-    "name: corrupt\n"
-    "time: {end: 1.0e-6}\n"
-    "materials:\n"
-    "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-    "bodies:\n"
-    "  - name: b\n"
-    "    material: steel\n"
-    "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.004}\n"
-    "    initial_velocity: [3, -1, 2]\n"
-    "    angular_velocity: [200, 500, -300]\n";
+const std::string kScene = test::steel_box_scene(
+    "corrupt", "0.004", "    initial_velocity: [3, -1, 2]\n    angular_velocity: [200, 500, -300]\n");
 
 struct Checkpoints {
   fs::path dir;
@@ -41,9 +33,10 @@ struct Checkpoints {
 
 Checkpoints& checkpoints() {
   static Checkpoints c = [] {
-    Checkpoints k{scratch_dir("checkpoint_corruption"), "", "",
-                  build_model(test::scene_from_text("corrupt", kScene))};
-    Model model = build_model(test::scene_from_text("corrupt", kScene));
+    // One folder per process: ctest runs each test of this file in its own.
+    Checkpoints k{scratch_dir("checkpoint_corruption_" + std::to_string(getpid())), "", "",
+                  build_model(test::scene_from_text("corrupt_" + std::to_string(getpid()), kScene))};
+    Model model = build_model(k.model.scene);
     Simulation sim(model, {});
     for (int s = 1; s <= 6; ++s) {
       sim.step();
@@ -158,7 +151,7 @@ TEST(CheckpointCorruption, BinaryRefusesWithOneLine) {
   std::string bad = c.a;
   bad[dataset_offset(c.a, "/state/velocities") + 5] ^= 0x10;
   std::ofstream(c.dir / "bad.h5", std::ios::binary | std::ios::trunc) << bad;
-  const std::string scene = test::write_scene("corrupt", kScene);
+  const std::string scene = test::write_scene("corrupt_binary", kScene);
   const auto r = run_shatter("run " + scene + " --quiet --out " + (c.dir / "out").string() + " --restart " +
                              (c.dir / "bad.h5").string());
   EXPECT_EQ(r.status, 2) << r.output;

@@ -18,18 +18,8 @@ using shatter::test::write_scene;
 
 namespace {
 
-const std::string kScene =
-    "name: restart_refusals\n"
-    "time: {end: 1.0e-6}\n"
-    "materials:\n"
-    "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-    "bodies:\n"
-    "  - name: b\n"
-    "    material: steel\n"
-    "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}\n"
-    "    initial_velocity: [1, 0, 0]\n"
-    "output: {every: 0}\n"
-    "checkpoint: {every_steps: 5}\n";
+const std::string kScene = shatter::test::steel_box_scene("restart_refusals", "0.005", "    initial_velocity: [1, 0, 0]\n",
+                                                           "output: {every: 0}\ncheckpoint: {every_steps: 5}\n");
 
 /// A finished run with a checkpoint at step 10 (11 steps in all).
 struct FinishedRun {
@@ -52,7 +42,8 @@ struct FinishedRun {
 };
 
 FinishedRun finished_run(const std::string& name) {
-  FinishedRun r{write_scene("restart_refusals", kScene), scratch_dir(name), {}};
+  // A scene file per test: ctest runs the tests of this file side by side.
+  FinishedRun r{write_scene(name, kScene), scratch_dir(name), {}};
   const auto out = run_shatter("run " + r.scene + " --quiet --out " + r.dir.string());
   EXPECT_EQ(out.status, 0) << out.output;
   r.keep();

@@ -4,10 +4,7 @@
 // file, the key path and what was expected; a stop during set-up says so.
 // Through the binary, as a user meets them.
 #include <gtest/gtest.h>
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <thread>
@@ -30,7 +27,7 @@ const std::string kBody =
     "  - name: b\n"
     "    material: steel\n"
     "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}\n";
-const std::string kGood = "name: strict\ntime: {end: 1.0e-6}\nmaterials:\n" + kMaterial + kBody;
+const std::string kGood = shatter::test::steel_box_scene("strict");
 
 void expect_refused(const shatter::test::CliOutcome& r, const std::vector<std::string>& parts) {
   EXPECT_EQ(r.status, 2) << r.output;
@@ -59,12 +56,12 @@ TEST(StrictInput, RepeatedKeysAreRefusedWithBothLines) {
                         "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005, element_size: 1}\n");
   expect_refused(run_shatter("check " + nested), {"bodies[0].mesh.element_size: duplicate key"});
   // In a --set value.
-  expect_refused(run_shatter("check " + write_scene("good_strict", kGood) + " --set 'time={end: 1, end: 2}'"),
+  expect_refused(run_shatter("check " + write_scene("strict_dup_set", kGood) + " --set 'time={end: 1, end: 2}'"),
                  {"--set time={end: 1, end: 2}", "time.end: duplicate key"});
 }
 
 TEST(StrictInput, SetIndexesAreDecimalIntegersOnly) {
-  const std::string scene = write_scene("good_strict", kGood);
+  const std::string scene = write_scene("strict_index", kGood);
   for (const char* index : {"0abc", "0x1", "-0", "+0", " 0", "", "1e0"})
     expect_refused(run_shatter("check " + scene + " --set 'bodies[" + index + "].material=steel'"),
                    {"expected a decimal index inside [ ], got '" + std::string(index) + "'"});
@@ -73,7 +70,7 @@ TEST(StrictInput, SetIndexesAreDecimalIntegersOnly) {
 
 TEST(StrictInput, UnusableOutputFolderIsRefusedBeforeMeshing) {
   const fs::path dir = scratch_dir("strict_output");
-  const std::string scene = write_scene("good_strict", kGood);
+  const std::string scene = write_scene("strict_output", kGood);
   std::ofstream(dir / "a_file") << "x";
   expect_refused(run_shatter("run " + scene + " --quiet --out " + (dir / "a_file" / "out").string()),
                  {"output folder " + (dir / "a_file" / "out").string() + ": cannot create it (Not a directory)"});
@@ -97,26 +94,15 @@ TEST(StrictInput, UnusableOutputFolderIsRefusedBeforeMeshing) {
 // SIGTERM while the mesher works (a fine mesh takes seconds): one line, exit 1.
 TEST(StrictInput, StopDuringSetUpSaysSo) {
   const fs::path dir = scratch_dir("strict_stop");
-  const std::string scene = write_scene("good_strict", kGood);
+  const std::string scene = write_scene("strict_stop", kGood);
   for (int sig : {SIGTERM, SIGINT}) {
-    const std::string log = (dir / "log.txt").string();
-    std::vector<std::string> args{std::string(SHATTER_BINARY_DIR) + "/apps/shatter", "run", scene, "--quiet",
-                                  "--out", (dir / "out").string(), "--set", "bodies[0].mesh.element_size=0.0002"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
+    const fs::path log = dir / "log.txt";
+    const shatter::test::Child c = shatter::test::start_shatter(
+        {"run", scene, "--quiet", "--out", (dir / "out").string(), "--set", "bodies[0].mesh.element_size=0.0002"},
+        log);
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-    kill(pid, sig);
-    int st = 0;
-    ASSERT_EQ(waitpid(pid, &st, 0), pid);
-    ASSERT_TRUE(WIFEXITED(st)) << "ended by signal " << WTERMSIG(st);
-    EXPECT_EQ(WEXITSTATUS(st), 1);
+    kill(c.pid, sig);
+    EXPECT_EQ(shatter::test::finish(c), 1);
     EXPECT_EQ(file_bytes(log), "error: stopped by signal " + std::to_string(sig) + (sig == SIGINT ? " (SIGINT)" : " (SIGTERM)") +
                                    " during set-up (before step 0): nothing to continue from; run it again\n");
     EXPECT_FALSE(fs::exists(dir / "out" / ".shatter_reserve"));
