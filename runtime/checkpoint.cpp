@@ -416,6 +416,7 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   const std::string scene = r.text(root, "scene");
   r.require(scene == model.scene.name, "the checkpoint is of scene '" + scene + "', not of '" +
                                            model.scene.name + "' (" + model.scene.file + ")");
+  if (run) run->history_every = 0;  // version 2: not recorded
   if (version >= 3) {
     const std::string physics = r.text(root, "physics");
     std::uint64_t scene_fp = 0;

@@ -158,3 +158,33 @@ TEST(CheckpointCorruption, BinaryRefusesWithOneLine) {
   EXPECT_EQ(r.output, "error: --restart " + (c.dir / "bad.h5").string() +
                           ": dataset velocities fails its hash check (corrupted checkpoint)\n");
 }
+
+// A checkpoint of format version 2 (before the physics keys and the
+// whole-file hash) is still read, without those checks.
+TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
+  Checkpoints& c = checkpoints();
+  const fs::path file = c.dir / "version2.h5";
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << c.a;
+  {
+    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t root = H5Gopen2(f, "/", H5P_DEFAULT);
+    const std::int64_t two = 2;
+    const hid_t version = H5Aopen(root, "version", H5P_DEFAULT);
+    EXPECT_GE(H5Awrite(version, H5T_NATIVE_INT64, &two), 0);
+    H5Aclose(version);
+    for (const char* name : {"physics", "scene_fingerprint", "history_every", "state_fnv1a64"})
+      EXPECT_GE(H5Adelete(root, name), 0) << name;
+    H5Gclose(root);
+    H5Fclose(f);
+  }
+  std::string softer = kScene;
+  softer.replace(softer.find("youngs_modulus: 210.0e9"), 23, "youngs_modulus: 100.0e9");
+  const Model model = build_model(test::scene_from_text("corrupt_v2_" + std::to_string(getpid()), softer));
+  CheckpointRun run;
+  run.history_every = -1;
+  EXPECT_EQ(read_checkpoint(file, model, &run).step, 3);
+  EXPECT_EQ(run.history_every, 0) << "not recorded in version 2";
+  // Version 3 refuses the same scene.
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << c.a;
+  EXPECT_THROW(read_checkpoint(file, model), InputError);
+}
