@@ -59,6 +59,13 @@ std::string lacking_space(const std::filesystem::path& dir, std::uintmax_t bytes
          std::to_string(needed / 1024) + " kB needed)";
 }
 
+bool output_folder_is_full() {
+  if (g_reserve[0] == '\0') return false;
+  std::error_code ec;
+  const std::filesystem::space_info s = std::filesystem::space(std::filesystem::path(g_reserve).parent_path(), ec);
+  return !ec && s.available < 64 * 1024;
+}
+
 const char* disk_reserve_path() {
   return g_reserve;
 }

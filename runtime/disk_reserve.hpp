@@ -30,6 +30,10 @@ void release_disk_space();
 /// whose flush failed (the reserve alone does not save that case).
 std::string lacking_space(const std::filesystem::path& dir, std::uintmax_t bytes);
 
+/// True when the folder of the reserve file has less than 64 kB free (the
+/// reason of a write that failed without an errno); false without a reserve.
+bool output_folder_is_full();
+
 /// The reserve file's path as a C string ("" when none), for a signal
 /// handler to unlink (async-signal-safe).
 const char* disk_reserve_path();

@@ -14,10 +14,12 @@
 namespace shatter {
 
 /// "HDF5 failed to <what>" plus, when a system call failed in it, the OS's
-/// reason (errno, cleared by the caller before the HDF5 calls); gives the
-/// disk reserve back.
+/// reason (errno, cleared by the caller before the HDF5 calls; MPI-IO does
+/// not always set it, and then a full output folder is told by its free
+/// space); gives the disk reserve back.
 inline std::string hdf5_write_failure(const std::string& what) {
-  const int err = errno;
+  int err = errno;
+  if (err == 0 && output_folder_is_full()) err = ENOSPC;
   release_disk_space();
   std::string message = "HDF5 failed to " + what;
   if (err != 0) message += std::string(" (") + std::strerror(err) + ")";
