@@ -79,6 +79,8 @@ class FractureStage {
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
+  /// The fragments' element ids and count (no statistics: no positions needed).
+  Fragments fragment_labels() const { return label_fragments(model_.mesh, topology_); }
   Index cohesive_count() const { return cohesive_.size(); }
   /// The crack surface (crack_area) with the fragments `frags` of the current state.
   CrackArea crack_area(const Fragments& frags) const {

@@ -14,22 +14,12 @@
 #include "runtime/failure.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/global_sum.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
 
 namespace shatter {
 namespace {
-
-struct Momenta {
-  double kinetic = 0;
-  Vec3 p = Vec3::Zero(), L = Vec3::Zero();
-  Momenta& operator+=(const Momenta& o) {
-    kinetic += o.kinetic;
-    p += o.p;
-    L += o.L;
-    return *this;
-  }
-};
 
 /// Runs f and adds its wall time to `seconds`.
 template <class F>
@@ -121,7 +111,6 @@ Simulation::Simulation(Model& model, RunOptions options)
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
   }
   ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
-  granule_sums_.assign(static_cast<size_t>(dec_->num_granules()) * kGranuleSums, 0.0);
   share_plans();
   compute_forces(0, 0.0);
   update_ledger();
@@ -190,9 +179,9 @@ void Simulation::compute_forces(long step, double time, const std::function<void
     const Index e = last_elements_.worst_element;
     Vec3 centre = Vec3::Zero();
     // The element's owner has its current positions.
-    if (e >= 0 && dec_->owns_granule(e / ElementForces::kGranule))
+    if (e >= 0 && dec_->owns_element(e))
       for (int a = 0; a < 4; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
-    dec_->combine_granules({centre.data(), 3});
+    if (e >= 0) dec_->broadcast({centre.data(), 3}, dec_->granule_rank(e / ElementForces::kGranule));
     std::ostringstream os;
     os << "step " << step << ", t = " << time << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
        << " (body '" << (e >= 0 ? model_.scene.bodies[model_.mesh.elem_body[e]].name : "?") << "') "
@@ -276,17 +265,11 @@ void Simulation::step() {
   // The ghost-only positions travel while the elements that do not read them
   // are computed (ElementForces::restrict_to).
   timed(comm_seconds_, [&] { dec_->begin_ghost_update(x_); });
-  // Gravity's work over the step's displacement (the projection's included),
-  // per home granule.
-  for (Index gr : dec_->owned_granules()) {
-    double w = 0;
-    if (g.squaredNorm() != 0)
-      for (Index i : dec_->home_nodes(gr))
-        w += model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
-    granule_sums_[gr * kGranuleSums + 8] = w;
-    granule_sums_[gr * kGranuleSums + 9] = 0;
-    granule_sums_[gr * kGranuleSums + 10] = 0;
-  }
+  // Gravity's work over the step's displacement (the projection's included).
+  if (g.squaredNorm() != 0)
+    step_work_[kGravityWork] += exact_sums<1>(dec_->owned_nodes(), [&](Index i, std::array<ExactSum, 1>& w) {
+      w[0] += model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt * v_[i]));
+    })[0];
 
   compute_forces(step_ + 1, time_ + dt, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
   if (book_contact_work_) {
@@ -295,20 +278,17 @@ void Simulation::step() {
     // (docs/contact.md, "The ledger with e < 1"); booked as contact dissipation.
     const std::vector<Index>& vertices = contact_->surface().vertices;
     for (size_t k = 0; k < vertices.size(); ++k) {
-      const Index i = vertices[k], gr = dec_->home_granule(i);
-      if (dec_->owns_granule(gr) &&
+      const Index i = vertices[k];
+      if (dec_->node_owner(i) == dec_->rank() &&
           (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero()))
-        granule_sums_[gr * kGranuleSums + 10] +=
-            (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
+        step_work_[kContactWork] += (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
     }
   }
 
   dec_->for_touched(n, half_kick);
-  for (size_t b = 0; b < bc_nodes_.size(); ++b) {
-    const Index gr = dec_->home_granule(bc_nodes_[b]);
-    if (dec_->owns_granule(gr))
-      granule_sums_[gr * kGranuleSums + 9] += 0.5 * (reaction_old[b] + reaction_[b]).dot(dx_bc[b]);
-  }
+  for (size_t b = 0; b < bc_nodes_.size(); ++b)
+    if (dec_->node_owner(bc_nodes_[b]) == dec_->rank())
+      step_work_[kReactionWork] += 0.5 * (reaction_old[b] + reaction_[b]).dot(dx_bc[b]);
   time_ += dt;
   ++step_;
   if (fracture_ && step_ % model_.scene.fracture_check_every == 0) apply_fracture();
@@ -325,10 +305,8 @@ void Simulation::apply_fracture() {
     // A facet is checked by the owner of its first element, which holds both
     // elements' stresses; every rank inserts the same list.
     const Topology& topo = fracture_->topology();
-    std::erase_if(critical, [&](Index f) {
-      const Index e = std::min(topo.facet_elem[f][0], topo.facet_elem[f][1]);
-      return !dec_->owns_granule(e / ElementForces::kGranule);
-    });
+    std::erase_if(critical,
+                  [&](Index f) { return !dec_->owns_element(std::min(topo.facet_elem[f][0], topo.facet_elem[f][1])); });
     critical = dec_->allgather(critical);
   }
   const Index before = fracture_->cohesive_count();
@@ -487,41 +465,29 @@ void Simulation::restore_state(const SimulationState& s) {
 }
 
 void Simulation::update_ledger() {
-  // Per granule, on its owner: sums over its home nodes in ascending order
-  // and its elements' strain energy; then the granules in order (the same
-  // bits for any decomposition and thread count).
-  const auto owned = dec_->owned_granules();
+  // Exact sums over the owned nodes, the owned granules' strain energy and
+  // the step's work, then over the ranks: the same bits for any
+  // decomposition and thread count.
+  constexpr int kKinetic = 0, kP = 1, kL = 4, kStrain = 7, kLocal = 8, kSums = kLocal + int{kStepWorks};
+  const std::array<ExactSum, kLocal> nodes =
+      exact_sums<kLocal>(dec_->owned_nodes(), [&](Index i, std::array<ExactSum, kLocal>& s) {
+        const Vec3 p = model_.mass[i] * v_[i], L = x_[i].cross(p);
+        s[kKinetic] += 0.5 * p.dot(v_[i]);
+        for (int c = 0; c < 3; ++c) s[kP + c] += p[c], s[kL + c] += L[c];
+      });
+  std::array<ExactSum, kSums> t;
+  std::copy(nodes.begin(), nodes.end(), t.begin());
   const std::span<const double> strain = elements_.granule_energy();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, owned.size()), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) {
-      const Index gr = owned[k];
-      Momenta m;
-      for (Index i : dec_->home_nodes(gr)) {
-        const Vec3 p = model_.mass[i] * v_[i];
-        m.kinetic += 0.5 * p.dot(v_[i]);
-        m.p += p;
-        m.L += x_[i].cross(p);
-      }
-      double* s = granule_sums_.data() + gr * kGranuleSums;
-      s[0] = m.kinetic;
-      for (int c = 0; c < 3; ++c) s[1 + c] = m.p[c], s[4 + c] = m.L[c];
-      s[7] = strain[gr];
-    }
-  });
-  std::vector<double> all = granule_sums_;
-  timed(comm_seconds_, [&] { dec_->combine_granules(all); });
-  double t[kGranuleSums] = {};
-  for (Index gr = 0; gr < dec_->num_granules(); ++gr)
-    for (int f = 0; f < kGranuleSums; ++f) t[f] += all[gr * kGranuleSums + f];
-  for (Index gr : owned)
-    granule_sums_[gr * kGranuleSums + 8] = granule_sums_[gr * kGranuleSums + 9] =
-        granule_sums_[gr * kGranuleSums + 10] = 0;
-  ledger_.kinetic = t[0];
-  ledger_.momentum = Vec3(t[1], t[2], t[3]);
-  ledger_.angular_momentum = Vec3(t[4], t[5], t[6]);
-  ledger_.strain = t[7];
-  ledger_.external_work += t[8] + t[9];
-  ledger_.contact_dissipated += t[10];
+  for (Index gr : dec_->owned_granules()) t[kStrain] += strain[gr];
+  std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);
+  step_work_ = {};
+  timed(comm_seconds_, [&] { dec_->sum(t); });
+  ledger_.kinetic = t[kKinetic].value();
+  ledger_.momentum = Vec3(t[kP].value(), t[kP + 1].value(), t[kP + 2].value());
+  ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());
+  ledger_.strain = t[kStrain].value();
+  ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value();
+  ledger_.contact_dissipated += t[kLocal + kContactWork].value();
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
                                               std::abs(ledger_.external_work));
@@ -539,13 +505,10 @@ std::array<std::span<const Vec3>, 2> Simulation::root_state(std::vector<Vec3>& x
 void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
   const bool root = dec_->rank() == 0;
-  // Every node's x and v on rank 0 (gathered on several ranks), when needed.
-  std::vector<Vec3> x_all, v_all;
-  std::array<std::span<const Vec3>, 2> xv;
-  if (fracture_ || (fields && fields_)) xv = root_state(x_all, v_all);
+  // The fragments' element ids: topology, the same on every rank.
   std::optional<Fragments> frags;
-  if (fracture_ && root) {
-    frags = fracture_->fragments(xv[0], xv[1], model_.mass);
+  if (fracture_) {
+    frags = fracture_->fragment_labels();
     ledger_.fragments = frags->count();
   }
   const Ledger& l = ledger_;
@@ -557,27 +520,24 @@ void Simulation::write_outputs(bool fields) {
     history_->end_row();
   }
 
-  // Body rows: mass, m x, m v per (home granule, body), granules in order.
+  // Body rows: mass, m x, m v per body, exact sums over the owned nodes.
   const Mesh& mesh = model_.mesh;
   const int nb = static_cast<int>(model_.scene.bodies.size());
-  const Index ng = dec_->num_granules();
-  std::vector<double> sums(static_cast<size_t>(ng) * nb * 7, 0.0);
-  for (Index gr : dec_->owned_granules())
-    for (Index i : dec_->home_nodes(gr)) {
-      double* r = sums.data() + (static_cast<size_t>(gr) * nb + mesh.node_body[i]) * 7;
-      const double m = model_.mass[i];
-      r[0] += m;
-      for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
-    }
-  dec_->combine_granules(sums);
+  std::vector<ExactSum> sums(static_cast<size_t>(nb) * 7);
+  for (Index i : dec_->owned_nodes()) {
+    ExactSum* r = sums.data() + static_cast<size_t>(mesh.node_body[i]) * 7;
+    const double m = model_.mass[i];
+    r[0] += m;
+    for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
+  }
+  timed(comm_seconds_, [&] { dec_->sum(sums); });
   std::vector<BodyRow> rows(nb);
-  for (Index gr = 0; gr < ng; ++gr)
-    for (int b = 0; b < nb; ++b) {
-      const double* r = sums.data() + (static_cast<size_t>(gr) * nb + b) * 7;
-      rows[b].mass += r[0];
-      rows[b].mx += Vec3(r[1], r[2], r[3]);
-      rows[b].mv += Vec3(r[4], r[5], r[6]);
-    }
+  for (int b = 0; b < nb; ++b) {
+    const ExactSum* r = sums.data() + static_cast<size_t>(b) * 7;
+    rows[b].mass = r[0].value();
+    rows[b].mx = Vec3(r[1].value(), r[2].value(), r[3].value());
+    rows[b].mv = Vec3(r[4].value(), r[5].value(), r[6].value());
+  }
   for (int b = 0; b < nb && root; ++b) {
     const Vec3 c = rows[b].mx / rows[b].mass, v = rows[b].mv / rows[b].mass;
     *bodies_ << step_ << time_ << model_.scene.bodies[b].name << rows[b].mass << c.x() << c.y() << c.z() << v.x()
@@ -588,6 +548,8 @@ void Simulation::write_outputs(bool fields) {
   if (fields && fields_) {
     // Rank 0 writes every row (from the owners' values); the others take
     // part in the collective writes with none.
+    std::vector<Vec3> x_all, v_all;
+    const std::array<std::span<const Vec3>, 2> xv = root_state(x_all, v_all);
     std::vector<Vec3> u;
     std::vector<double> stress, vm;
     FieldFrame f;
@@ -711,16 +673,20 @@ long Simulation::run() {
     const CrackArea crack = fracture_ ? write_fragments() : CrackArea{};
     const DecompositionStats stats = dec_->stats();
     const std::array<long, 3> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 3>{};
-    if (root) write_summary(wall, stats, pairs, crack);
+    const std::pair<std::vector<long>, long> memory{dec_->gather(peak_memory_bytes()), dec_->max(loop_bytes())};
+    if (root) write_summary(wall, stats, pairs, crack, memory);
   }
   return step_;
 }
 
 CrackArea Simulation::write_fragments() {
-  std::vector<Vec3> x_all, v_all;
-  const auto xv = root_state(x_all, v_all);
+  // Each rank sums its owned nodes and elements, exactly; rank 0 adds the ranks' sums.
+  Fragments frags = fracture_->fragment_labels();
+  std::vector<ExactSum> sums = fragment_sums(model_.mesh, frags, dec_->owned_nodes(), dec_->owned_element_ids(), x_,
+                                             v_, model_.mass);
+  if (dec_->distributed()) reduce_to_root(sums, dec_->comm());
   if (dec_->rank() != 0) return {};
-  const Fragments frags = fracture_->fragments(xv[0], xv[1], model_.mass);
+  set_fragment_stats(frags, sums);
   CsvWriter out(opt_.out_dir / "fragments.csv",
                 {"id", "mass", "volume", "cx", "cy", "cz", "vx", "vy", "vz", "elements"});
   for (Index k = 0; k < frags.count(); ++k) {
@@ -732,8 +698,14 @@ CrackArea Simulation::write_fragments() {
   return fracture_->crack_area(frags);
 }
 
+long Simulation::loop_bytes() const {
+  auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
+  return static_cast<long>(model_bytes(model_)) + b(x_) + b(v_) + b(a_) + b(f_int_) + b(f_ext_) + b(inv_mass_) +
+         b(bc_nodes_) + b(reaction_) + b(x_prev_) + b(contact_inv_mass_) + b(stress6_);
+}
+
 void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs,
-                               const CrackArea& crack) {
+                               const CrackArea& crack, const std::pair<std::vector<long>, long>& memory) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -750,6 +722,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("element_updates_per_second",
         element_seconds_ > 0 ? double(dec_->local_elements().size()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
+  j.add("peak_memory_bytes_per_rank", memory.first);
+  j.add("model_bytes_per_rank_max", memory.second);
   // Decomposition (docs/parallel.md): balance and bytes per step.
   j.add("owned_elements_min", stats.owned_min);
   j.add("owned_elements_max", stats.owned_max);
@@ -757,7 +731,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
   j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
-  j.add("granule_sum_bytes_per_step", static_cast<long>(dec_->distributed() ? 8 * granule_sums_.size() : 0));
+  // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
+  j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(8 + kStepWorks) : 0));
   // The contact stage's exchanges included (contact_exchange_time).
   j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
   j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));

@@ -161,8 +161,13 @@ class Simulation {
   void update_ledger();
   void write_outputs(bool fields);
   /// `crack`: the crack surface at the end (fracture only; write_fragments).
+  /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
   void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range,
-                     const CrackArea& crack);
+                     const CrackArea& crack, const std::pair<std::vector<long>, long>& memory);
+  /// Bytes of the arrays this rank holds in the loop: the model's and the
+  /// time loop's own (nodal state, stresses); the contact and fracture
+  /// stages' are not counted.
+  long loop_bytes() const;
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
@@ -170,16 +175,16 @@ class Simulation {
   /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.
   double next_dt();
 
-  /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
-  /// strain, the step's gravity work, the step's reaction work, the step's contact work
-  /// f(n+1) . (dx - dt/2 dv) (book_contact_work_).
-  static constexpr int kGranuleSums = 11;
+  /// The step's work terms, exact sums over this rank's owned nodes, summed
+  /// over the ranks by update_ledger: gravity's work, the reactions' work and,
+  /// with book_contact_work_, the contact's f(n+1) . (dx - dt/2 dv).
+  enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
 
   Model& model_;
   RunOptions opt_;
   std::unique_ptr<Decomposition> dec_;
   ElementForces elements_;
-  std::vector<double> granule_sums_;  ///< [g * kGranuleSums + field], this rank's granules only
+  std::array<ExactSum, kStepWorks> step_work_;  ///< since the last update_ledger(), this rank's part
   std::unique_ptr<SharedNodes> surface_nodes_;   ///< contact surface vertices shared by all ranks
   std::unique_ptr<SharedNodes> cohesive_nodes_;  ///< cohesive element nodes shared by all ranks
   /// After a topology change on several ranks: restrict the element loop to
@@ -220,8 +225,8 @@ class Simulation {
   /// Writes fragments.csv from rank 0 (collective); returns the crack surface
   /// between those fragments on rank 0, zeros elsewhere.
   CrackArea write_fragments();
-  /// x and v of every node on rank 0: the own arrays on one rank, else
-  /// gathered from the owners into `x` and `v` (collective).
+  /// x and v of every node on rank 0 (for the field frames): the own arrays
+  /// on one rank, else gathered from the owners into `x` and `v` (collective).
   std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);
 };
 

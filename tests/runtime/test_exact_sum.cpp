@@ -1,4 +1,4 @@
-// Exact summation (runtime/exact_sum.hpp): the sum of any doubles, in any
+// Exact summation (kernels/exact_sum.hpp, runtime/global_sum.hpp): the sum of any doubles, in any
 // order and any grouping, is the same integer and so the same double; it is
 // the correctly rounded sum where that is known; and split over 1, 2 or 3
 // MPI ranks it gives the serial bits.
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "mpi_environment.hpp"
-#include "runtime/exact_sum.hpp"
+#include "runtime/global_sum.hpp"
 
 namespace shatter {
 namespace {
