@@ -54,8 +54,11 @@ class FractureStage {
   CohesiveEnergy add_forces(std::span<const Vec3> x, std::span<Vec3> f_int);
 
   /// Facets whose traction (from the elements' Cauchy stresses, 6 Voigt
-  /// components per element) reaches the strength, sorted by facet gid.
-  std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6);
+  /// components per element) reaches the strength, sorted by facet gid; on
+  /// MPI ranks those whose smaller element is owned (critical_facets: `local`
+  /// and `owned` elements, empty on one rank).
+  std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6,
+                           std::span<const Index> local = {}, std::span<const Index> owned = {});
   /// The facets become cohesive elements (in canonical order, whatever the
   /// order given); nodes split. Returns what changed (new nodes to fill in by
   /// the caller).

@@ -300,15 +300,11 @@ void Simulation::apply_fracture() {
   // Every rank holds the positions of every cohesive node (compute_forces),
   // so releases are the same everywhere.
   fracture_->release(x_);
-  std::vector<Index> critical = fracture_->check(x_, stress6_);
-  if (dec_->distributed()) {
-    // A facet is checked by the owner of its first element, which holds both
-    // elements' stresses; every rank inserts the same list.
-    const Topology& topo = fracture_->topology();
-    std::erase_if(critical,
-                  [&](Index f) { return !dec_->owns_element(std::min(topo.facet_elem[f][0], topo.facet_elem[f][1])); });
-    critical = dec_->allgather(critical);
-  }
+  // A facet is checked by the owner of its smaller element, which holds both
+  // elements' stresses; every rank inserts the same list.
+  std::vector<Index> critical = dec_->distributed() ? dec_->allgather(fracture_->check(
+                                                          x_, stress6_, dec_->local_elements(), dec_->owned_element_ids()))
+                                                    : fracture_->check(x_, stress6_);
   const Index before = fracture_->cohesive_count();
   const Insertion ins = fracture_->insert(critical);
   ledger_.cohesive_elements = fracture_->cohesive_count();
