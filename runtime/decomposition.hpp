@@ -17,11 +17,12 @@
 //   - receives each step the positions of its ghost-only nodes (held through
 //     the ghost layer, not touched) from their owner, the smallest rank
 //     touching them (Halo, nonblocking).
-// Global sums (energies, momenta, work, body rows) are exact (ExactSum,
-// kernels/exact_sum.hpp): each rank adds the terms of the nodes it OWNS (the
-// smallest rank touching a node) and of its owned elements, and one
-// reduction of constant size (sum()) adds the ranks' integers. The result is
-// the same double on every rank and for any decomposition and thread count.
+// Global sums (energies, momenta, work, body rows) are summed per granule by
+// the granule's owner, in a fixed order - a node counts in its HOME granule,
+// the granule of the first element of its star - and the granules' partial
+// sums are added exactly (ExactSum, kernels/exact_sum.hpp) and reduced over
+// the ranks by one reduction of constant size (sum()). The result is the
+// same double on every rank and for any decomposition and thread count.
 // With one rank (or MPI not initialised) nothing is communicated.
 #include <mpi.h>
 
@@ -83,9 +84,17 @@ class Decomposition {
   std::span<const Index> held_nodes() const { return held_nodes_; }
   /// Nodes of owned elements (integrated here), ascending.
   std::span<const Index> touched_nodes() const { return touched_nodes_; }
-  /// Nodes owned here (node_owner() == rank()), ascending: the nodes whose
-  /// terms this rank adds to global sums.
+  /// The home nodes of the k-th owned granule (owned_granules()[k]), ascending:
+  /// the nodes whose home granule (the granule of the first element of their
+  /// star) it is. A node's terms in global sums are added by its home
+  /// granule's owner, which touches it.
+  std::span<const Index> home_nodes(size_t k) const {
+    return {home_nodes_.data() + home_offsets_[k], static_cast<size_t>(home_offsets_[k + 1] - home_offsets_[k])};
+  }
+  /// The home nodes of all owned granules, ascending.
   std::span<const Index> owned_nodes() const { return owned_nodes_; }
+  /// Whether this rank adds node n's terms to global sums (it owns n's home granule).
+  bool owns_node(Index n) const { return owns_granule(home_granule_[n]); }
   /// Elements of the owned granules, ascending.
   std::span<const Index> owned_element_ids() const { return owned_element_ids_; }
   /// Whether element e is owned here.
@@ -146,6 +155,8 @@ class Decomposition {
   std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending (empty on one rank)
   std::vector<Index> local_elements_, held_nodes_, touched_nodes_, ghost_only_nodes_;
   std::vector<Index> owned_nodes_, owned_element_ids_;
+  std::vector<Index> home_granule_;               ///< per node
+  std::vector<Index> home_offsets_, home_nodes_;  ///< CSR over the owned granules' index k
   std::unique_ptr<Halo> halo_;
   SharedNodes all_nodes_;
 };

@@ -19,6 +19,17 @@
 
 namespace shatter {
 
+template <int K, class Term>
+std::array<ExactSum, K> Simulation::granule_sums(Term term) const {
+  std::vector<Index> slots(dec_->owned_granules().size());
+  for (size_t k = 0; k < slots.size(); ++k) slots[k] = static_cast<Index>(k);
+  return exact_sums<K>(slots, [&](Index k, std::array<ExactSum, K>& sums) {
+    std::array<double, K> partial{};
+    for (Index i : dec_->home_nodes(k)) term(i, partial);
+    for (int c = 0; c < K; ++c) sums[c] += partial[c];
+  });
+}
+
 Simulation::Simulation(Model& model, RunOptions options)
     : model_(model),
       opt_(std::move(options)),
@@ -211,7 +222,7 @@ void Simulation::book_gravity_work() {
   // Gravity's work over the step's displacement (the projection's included).
   const Vec3 g = model_.scene.gravity;
   if (g.squaredNorm() == 0) return;
-  step_work_[kGravityWork] += exact_sums<1>(dec_->owned_nodes(), [&](Index i, std::array<ExactSum, 1>& w) {
+  step_work_[kGravityWork] += granule_sums<1>([&](Index i, std::array<double, 1>& w) {
     w[0] += model_.mass[i] * g.dot(contact_ ? Vec3(x_[i] - x_prev_[i]) : Vec3(dt_ * v_[i]));
   })[0];
 }
@@ -224,7 +235,7 @@ void Simulation::book_contact_work() {
   const std::vector<Index>& vertices = contact_->surface().vertices;
   for (size_t k = 0; k < vertices.size(); ++k) {
     const Index i = vertices[k];
-    if (dec_->node_owner(i) == dec_->rank() && (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero()))
+    if (dec_->owns_node(i) && (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero()))
       step_work_[kContactWork] += (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
   }
 }
@@ -233,7 +244,7 @@ void Simulation::correct(const std::vector<Vec3>& reaction_old) {
   half_kick();
   // The reactions' work by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
   for (size_t b = 0; b < bc_nodes_.size(); ++b)
-    if (dec_->node_owner(bc_nodes_[b]) == dec_->rank())
+    if (dec_->owns_node(bc_nodes_[b]))
       step_work_[kReactionWork] += 0.5 * (reaction_old[b] + reaction_[b]).dot(bc_dx_[b]);
 }
 
@@ -316,16 +327,15 @@ void Simulation::node_arrays_from_model() {
 }
 
 void Simulation::update_ledger() {
-  // Exact sums over the owned nodes, the owned granules' strain energy and
-  // the step's work, then over the ranks: the same bits for any
-  // decomposition and thread count.
+  // Per owned granule over its home nodes, exact over the granules, the
+  // step's work, then over the ranks: the same bits for any decomposition
+  // and thread count.
   constexpr int kKinetic = 0, kP = 1, kL = 4, kStrain = 7, kLocal = 8, kSums = kLocal + int{kStepWorks};
-  const std::array<ExactSum, kLocal> nodes =
-      exact_sums<kLocal>(dec_->owned_nodes(), [&](Index i, std::array<ExactSum, kLocal>& s) {
-        const Vec3 p = model_.mass[i] * v_[i], L = x_[i].cross(p);
-        s[kKinetic] += 0.5 * p.dot(v_[i]);
-        for (int c = 0; c < 3; ++c) s[kP + c] += p[c], s[kL + c] += L[c];
-      });
+  const std::array<ExactSum, kStrain> nodes = granule_sums<kStrain>([&](Index i, std::array<double, kStrain>& s) {
+    const Vec3 p = model_.mass[i] * v_[i], L = x_[i].cross(p);
+    s[kKinetic] += 0.5 * p.dot(v_[i]);
+    for (int c = 0; c < 3; ++c) s[kP + c] += p[c], s[kL + c] += L[c];
+  });
   std::array<ExactSum, kSums> t;
   std::copy(nodes.begin(), nodes.end(), t.begin());
   const std::span<const double> strain = elements_.granule_energy();

@@ -133,6 +133,12 @@ class Simulation {
   /// ElementForces::compute: it completes the ghost-only positions.
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
+  /// K sums over this rank's owned nodes of term(node, partial), each owned
+  /// granule's home nodes added in plain double in node order, the granules'
+  /// partial sums exactly (any thread split gives the same bits; a node costs
+  /// K double additions, the exact ones are per granule).
+  template <int K, class Term>
+  std::array<ExactSum, K> granule_sums(Term term) const;
   void write_outputs(bool fields);
   /// `crack`: the crack surface at the end (fracture only; write_fragments).
   /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.

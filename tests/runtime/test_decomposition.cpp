@@ -54,11 +54,20 @@ TEST(Decomposition, OwnershipCoversEverythingOnce) {
   MPI_Allreduce(&owned, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(total, d.num_granules());
   for (Index g : d.owned_granules()) EXPECT_TRUE(d.owns_granule(g));
-  // Owned nodes split the nodes: each node owned by one rank, the smallest touching it.
+  // Home granules split the nodes: each node once, in the granule of its
+  // first element, on that granule's owner.
   std::vector<int> seen(mesh.num_nodes(), 0);
+  const auto granules = d.owned_granules();
+  size_t homed = 0;
+  for (size_t k = 0; k < granules.size(); ++k)
+    for (Index n : d.home_nodes(k)) {
+      EXPECT_EQ(mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule, granules[k]);
+      ++homed;
+    }
+  EXPECT_EQ(homed, d.owned_nodes().size());
   for (Index n : d.owned_nodes()) {
     seen[n] = 1;
-    EXPECT_EQ(d.node_owner(n), d.rank());
+    EXPECT_TRUE(d.owns_node(n));
   }
   MPI_Allreduce(MPI_IN_PLACE, seen.data(), static_cast<int>(seen.size()), MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   for (Index n = 0; n < mesh.num_nodes(); ++n) EXPECT_EQ(seen[n], 1) << "node " << n;
