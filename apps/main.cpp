@@ -85,24 +85,6 @@ int plot_outputs(const std::string& out_dir) {
   return WEXITSTATUS(wstatus);
 }
 
-/// The one message of a failure and the exit status (runtime/failure.hpp):
-/// when every rank failed, rank 0 prints it; a rank that failed alone prints
-/// it and ends every rank with MPI_Abort.
-int report_failure(FailureChannel& failures, int status, const char* message, int rank, int ranks) {
-  const FailureAgreement a = failures.agree(status);
-  if (!a.all_ranks) {
-    std::fprintf(stderr,
-                 "error: %s\n(rank %d of %d failed alone while the others waited in a collective: "
-                 "every rank is ended with MPI_Abort; no checkpoint of this failure, an earlier "
-                 "one stays)\n",
-                 message, rank, ranks);
-    std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, status);
-  }
-  if (rank == 0) std::fprintf(stderr, "error: %s\n", message);
-  return a.status;
-}
-
 int cli(int argc, char** argv, FailureChannel& failures) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -152,9 +134,6 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     opt.quiet = quiet;
     opt.deterministic = deterministic;
     opt.failures = &failures;
-    if (const char* fail = std::getenv("SHATTER_TEST_FAIL"))
-      if (std::sscanf(fail, "%d:%ld", &opt.fail_rank, &opt.fail_step) != 2)
-        throw InputError(std::string("SHATTER_TEST_FAIL=") + fail + ": expected RANK:STEP");
     if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
     // A restart continues the outputs beside its checkpoint unless --out says otherwise.
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
@@ -179,9 +158,9 @@ int cli(int argc, char** argv, FailureChannel& failures) {
                      sim->energy_error(), opt.out_dir.c_str());
     }
   } catch (const InputError& e) {
-    return report_failure(failures, 2, e.what(), rank, ranks);
+    return report_failure(failures, 2, e.what());
   } catch (const std::exception& e) {
-    return report_failure(failures, 1, e.what(), rank, ranks);
+    return report_failure(failures, 1, e.what());
   }
   return 0;
 }

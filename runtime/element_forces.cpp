@@ -7,6 +7,7 @@
 
 #include "kernels/tet10.hpp"
 #include "kernels/error.hpp"
+#include "kernels/exact_sum.hpp"
 #include "kernels/tet4.hpp"
 
 namespace shatter {
@@ -203,7 +204,9 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
   }
 
   ElementLoopResult res;
-  for (double e : granule_energy_) res.strain_energy += e;
+  ExactSum energy;
+  for (double e : granule_energy_) energy += e;
+  res.strain_energy = energy.value();
   for (size_t b = 0; b < block_dt_.size(); ++b) {
     res.stable_dt = std::min(res.stable_dt, block_dt_[b]);
     if (worse(block_min_J_[b], res.min_jacobian)) {

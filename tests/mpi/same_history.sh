@@ -1,5 +1,5 @@
 #!/bin/bash
-# The same scene on 1x1, 2x1, 1x2 and 3x1 ranks x threads must give the same
+# The same scene on 1x1, 2x1, 1x2, 3x1 and 4x1 ranks x threads must give the same
 # history.csv and bodies.csv (and fragments.csv), byte for byte (issue 6:
 # "bitwise with --deterministic"; the decomposed loop is bitwise for any
 # decomposition, so the flag changes nothing). Also checks that summary.json
@@ -22,8 +22,9 @@ run 1 1
 run 2 1
 run 1 2
 run 3 1
+run 4 1
 status=0
-for d in r2t1 r1t2 r3t1; do
+for d in r2t1 r1t2 r3t1 r4t1; do
   for f in history.csv bodies.csv $([ "$kind" = fracture ] && echo fragments.csv); do
     if ! cmp -s "$work/r1t1/$f" "$work/$d/$f"; then
       echo "FAIL: $d/$f differs from r1t1/$f:"
@@ -46,5 +47,5 @@ else
   what="$n cohesive elements across ranks at 3 ranks"
 fi
 [ "${n:-0}" -gt 0 ] || { echo "FAIL: $what: the comparison does not cover $kind"; status=1; }
-[ $status -eq 0 ] && echo "same outputs at 1x1, 2x1, 1x2, 3x1 ($what)"
+[ $status -eq 0 ] && echo "same outputs at 1x1, 2x1, 1x2, 3x1, 4x1 ($what)"
 exit $status
