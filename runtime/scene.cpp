@@ -20,6 +20,9 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
+  /// Characters of a bad value quoted in a message.
+  static constexpr std::size_t kMaxEcho = 200;
+
   [[noreturn]] void fail(const std::string& key, const std::string& expected, const YAML::Node& got) const {
     std::ostringstream os;
     os << file_ << ": " << key << ": expected " << expected;
@@ -28,7 +31,14 @@ class Reader {
       e.SetMapFormat(YAML::Flow);
       e.SetSeqFormat(YAML::Flow);
       e << got;
-      os << ", got '" << e.c_str() << "'";
+      // A long value is cut (at a UTF-8 character's start): the message stays one readable line.
+      std::string text = e.c_str();
+      if (text.size() > kMaxEcho) {
+        std::size_t cut = kMaxEcho;
+        while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+        text = text.substr(0, cut) + "... (" + std::to_string(text.size()) + " characters)";
+      }
+      os << ", got '" << text << "'";
     } else {
       os << ", but it is missing";
     }
@@ -170,6 +180,12 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& key, const
   }
 }
 
+void refuse_large_scene(std::uintmax_t bytes, const std::string& path) {
+  if (bytes > kMaxSceneBytes)
+    throw InputError(path + ": the scene file is " + std::to_string(bytes) + " bytes; expected at most " +
+                     std::to_string(kMaxSceneBytes) + " (1 MiB: a scene names shapes, mesh files and numbers)");
+}
+
 ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& key) {
   ShapeSpec s;
   s.shape = r.string(r.required(m, key, "shape"), key + ".shape");
@@ -221,6 +237,9 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
   if (!std::filesystem::is_regular_file(path))
     throw InputError(path + ": the scene file does not exist or is not a file");
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec) refuse_large_scene(bytes, path);
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
@@ -229,6 +248,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 }
 
 Scene parse_scene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  refuse_large_scene(text.size(), path);
   Reader r(path);
   YAML::Node root;
   try {

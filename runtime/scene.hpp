@@ -3,6 +3,7 @@
 // strictly before anything runs. Every error is an InputError naming the
 // file, the key path (bodies[1].mesh.radius) and what was expected.
 #include <array>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -83,6 +84,12 @@ struct Scene {
     return false;
   }
 };
+
+/// The largest scene file read, bytes (1 MiB: a scene names shapes, files and
+/// numbers, a few kB; yaml-cpp needs ~100 times the text in memory and ~0.7 s
+/// per MiB, so a 50 MB file took 40 s and 5.8 GB only to be refused).
+/// load_scene and parse_scene refuse a larger one before parsing it.
+inline constexpr std::size_t kMaxSceneBytes = std::size_t{1} << 20;
 
 /// Load and check a scene. `overrides` are "key.path=value" strings (the
 /// CLI's --set), applied to the YAML tree before checking; value is YAML.

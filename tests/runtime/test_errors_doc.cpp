@@ -123,6 +123,11 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
   shatter::write_checkpoint(dir / "run" / "checkpoint.h5", good, state);
   std::ofstream(dir / "run" / "history.csv") << "step,time,dt,kinetic\n";
   std::ofstream(dir / "run" / "bodies.csv") << "step,time,body,mass\n";
+  {
+    std::string huge = base_scene + "#";
+    huge += std::string(shatter::kMaxSceneBytes + 1 - huge.size() - 1, 'x') + "\n";
+    std::ofstream(dir / "huge.yaml") << huge;
+  }
   std::ofstream(dir / "dup.yaml") << "name: x\ntime: {end: 1}\ntime: {end: 2}\n";
   fs::create_directories(dir / "taken" / "fields.h5");
   fs::create_directories(dir / "device");
