@@ -1,5 +1,6 @@
 #include "runtime/model.hpp"
 
+#include <array>
 #include <sstream>
 
 #include "kernels/error.hpp"
@@ -87,7 +88,13 @@ Model build_model(const Scene& scene) {
 
   m.bc_mask.assign(nn, 0);
   m.bc_velocity.assign(nn, Vec3::Zero());
-  for (const auto& bc : scene.boundary_conditions) {
+  // Per node and component, the condition that prescribed it: two that give
+  // one component of one node different values contradict each other (the
+  // last would win silently); the same value twice (overlapping regions that
+  // fix the same corner) is accepted.
+  std::vector<std::array<int, 3>> set_by(scene.boundary_conditions.empty() ? 0 : nn, {-1, -1, -1});
+  for (std::size_t k = 0; k < scene.boundary_conditions.size(); ++k) {
+    const BoundaryConditionSpec& bc = scene.boundary_conditions[k];
     Index hits = 0;
     for (Index i = 0; i < nn; ++i) {
       if (mesh.node_body[i] != bc.body) continue;
@@ -96,6 +103,18 @@ Model build_model(const Scene& scene) {
       ++hits;
       for (int c = 0; c < 3; ++c)
         if (bc.velocity[c]) {
+          const int first = set_by[i][c];
+          if (first >= 0 && m.bc_velocity[i][c] != *bc.velocity[c]) {
+            const std::string comp = ".velocity[" + std::to_string(c) + "]";
+            std::ostringstream os;
+            os << scene.file << ": " << bc.key << comp << ": prescribes " << *bc.velocity[c] << " m/s on node "
+               << mesh.node_gid[i] << " of body '" << scene.bodies[bc.body].name << "' at (" << X.x() << ", "
+               << X.y() << ", " << X.z() << "), where " << scene.boundary_conditions[first].key << comp
+               << " prescribes " << m.bc_velocity[i][c]
+               << " m/s; expected one value per component of a node (regions that overlap must agree)";
+            throw InputError(os.str());
+          }
+          set_by[i][c] = static_cast<int>(k);
           m.bc_mask[i] |= static_cast<std::uint8_t>(1u << c);
           m.bc_velocity[i][c] = *bc.velocity[c];
           m.initial_velocity[i][c] = *bc.velocity[c];

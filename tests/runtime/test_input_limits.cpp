@@ -61,3 +61,24 @@ TEST(InputLimits, LongBadValuesAreCutInTheMessage) {
                      "... (15003 characters)'"});
   EXPECT_LT(r.output.size(), 400u) << r.output;
 }
+
+// Two conditions giving one component of one node different values: the last
+// used to win. Now exit 2 with both key paths, the node and where it is. The
+// same value twice (regions that overlap on a fixed edge) is accepted.
+TEST(InputLimits, ConflictingConditionsNameBoth) {
+  const std::string scene = write_scene("limits_bc", kGood);
+  const std::string first = "{body: b, region: {box: [[-1, -1, -1], [-0.004, 1, 1]]}, velocity: [0, null, 0]}";
+  const auto with = [&](const std::string& second) {
+    return run_shatter("check " + scene + " --set 'boundary_conditions=[" + first + ", " + second + "]'");
+  };
+  expect_refused(with("{body: b, region: {box: [[-1, -1, -1], [1, -0.004, 1]]}, velocity: [null, 1, 2.5]}"),
+                 {scene + ": boundary_conditions[1].velocity[2]: prescribes 2.5 m/s on node ",
+                  " of body 'b' at (-0.005, -0.005, ",
+                  "where boundary_conditions[0].velocity[2] prescribes 0 m/s; expected one value per component of "
+                  "a node (regions that overlap must agree)"});
+  const auto same = with("{body: b, region: {box: [[-1, -1, -1], [1, -0.004, 1]]}, velocity: [0, 1, 0]}");
+  EXPECT_EQ(same.status, 0) << same.output;
+  // Different components of one node do not conflict.
+  const auto apart = with("{body: b, region: {box: [[-1, -1, -1], [1, -0.004, 1]]}, velocity: [null, 1, null]}");
+  EXPECT_EQ(apart.status, 0) << apart.output;
+}
