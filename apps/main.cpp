@@ -104,7 +104,7 @@ int cli(int argc, char** argv, FailureChannel& failures) {
   run->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
   run->add_flag("--deterministic", deterministic, "bitwise identical results for any ranks and threads");
   run->add_option("--restart", restart, "continue from a checkpoint");
-  run->add_flag("--quiet", quiet, "no progress line");
+  run->add_flag("--quiet", quiet, "no progress line and no closing 'done' line; warnings and errors still print");
   auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
   check->add_option("scene", scene_path, "scene file (YAML)")->required();
   check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");

@@ -70,7 +70,8 @@ Simulation::Simulation(Model& model, RunOptions options)
   total0_ = ledger_.total();
   stable_dt0_ = stable_dt_;
   energy_scale_ = std::max(ledger_.kinetic + ledger_.strain, 1e-300);
-  if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && !opt_.quiet && dec_->rank() == 0)
+  // Warnings are not progress: --quiet does not hide them (README, "Command line").
+  if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && dec_->rank() == 0)
     std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
                  model_.scene.file.c_str(), *model_.scene.fixed_dt, stable_dt_);
 }
@@ -209,7 +210,7 @@ void Simulation::resolve_contact() {
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
       throw Error(sweep_cap_diagnosis(model_, x_, contact_->candidates(), r, step_ + 1, time_ + dt_));
-    if (ledger_.contact_capped_steps == 0 && !opt_.quiet && dec_->rank() == 0)
+    if (ledger_.contact_capped_steps == 0 && dec_->rank() == 0)
       std::fprintf(stderr,
                    "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
                    "counted in history.csv column contact_capped_steps\n",

@@ -45,7 +45,7 @@ struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
   int threads = 1;
   int ranks = 1;
-  bool quiet = false;
+  bool quiet = false;  ///< no progress line (warnings are printed all the same)
   bool deterministic = false;
   /// Several ranks: the ranks agree through it whether a failed step failed on
   /// every rank (then the last good state is checkpointed) or on this one

@@ -82,3 +82,17 @@ TEST(InputLimits, ConflictingConditionsNameBoth) {
   const auto apart = with("{body: b, region: {box: [[-1, -1, -1], [1, -0.004, 1]]}, velocity: [null, 1, null]}");
   EXPECT_EQ(apart.status, 0) << apart.output;
 }
+
+// --quiet hides the progress line and the closing 'done' line, not a warning:
+// time.dt above the stable step still says the run may blow up.
+TEST(InputLimits, QuietHidesProgressNotWarnings) {
+  const fs::path dir = scratch_dir("limits_quiet");
+  const std::string scene = write_scene("limits_quiet", kGood);
+  const auto r = run_shatter("run " + scene + " --quiet --out " + dir.string() +
+                             " --set time.dt=1.0e-6 --set time.end=1.0e-6");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: " + scene + ": time.dt = 1.000e-06 s is above the stable step"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("done:"), std::string::npos) << r.output;
+}
