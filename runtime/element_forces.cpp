@@ -14,7 +14,50 @@ namespace shatter {
 namespace {
 // a is a worse volume ratio than b: NaN beats everything, then the smaller.
 bool worse(double a, double b) { return std::isnan(a) ? !std::isnan(b) : a < b; }
+
+// The N TET4 elements es[0..N) at positions x into the lanes, forces and
+// det F computed.
+template <int N>
+void tet4_lanes(const Model& model, std::span<const Vec3> x, const Index* es, const NeoHookean& m, Tet4Lanes<N>& L) {
+  for (int l = 0; l < N; ++l) {
+    const Index* c = model.mesh.conn.data() + 4 * static_cast<size_t>(es[l]);
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = x[c[a]][i];
+    const double* D = model.tet4_Dm_inv[es[l]].data();
+    for (int q = 0; q < 9; ++q) L.Dm_inv[q][l] = D[q];
+    L.V0[l] = model.element_volume[es[l]];
+  }
+  tet4_neo_hookean_lanes(L, m);
+}
+
+// TET10 element e at positions x: its forces, and its stable step h / c(J) in `dt`.
+Tet10Force tet10_element(const Model& model, std::span<const Vec3> x, Index e, double& dt) {
+  const NeoHookean& m = model.materials[model.mesh.elem_material[e]];
+  const Index* c = model.mesh.conn.data() + 10 * static_cast<size_t>(e);
+  Tet10Nodes xe;
+  for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
+  const Tet10Force out = tet10_internal_force(xe, model.tet10_ref[e], m);
+  const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
+  // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
+  dt = h / m.wave_speed(out.J > 0 ? out.J : 1.0);
+  return out;
+}
 }  // namespace
+
+ElementStep element_stable_step(const Model& model, std::span<const Vec3> x, Index e) {
+  ElementStep r;
+  if (model.mesh.order == 1) {
+    Tet4Lanes<1> L;
+    tet4_lanes<1>(model, x, &e, model.materials[model.mesh.elem_material[e]], L);
+    double dt2[1];
+    tet4_stable_dt_squared_lanes(L, model.materials[model.mesh.elem_material[e]], dt2);
+    r.dt = std::sqrt(dt2[0]);
+    r.J = L.J[0];
+  } else {
+    r.J = tet10_element(model, x, e, r.dt).J;
+  }
+  return r;
+}
 
 ElementForces::ElementForces(const Model& model) : model_(model) { rebuild(); }
 
@@ -116,15 +159,7 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
   auto tet4_group = [&]<int N>(const Index* es, const NeoHookean& m, double& energy, double& dt2, double& minJ,
                                Index& worst) {
     Tet4Lanes<N> L;
-    for (int l = 0; l < N; ++l) {
-      const Index* c = conn + 4 * static_cast<size_t>(es[l]);
-      for (int a = 0; a < 4; ++a)
-        for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = x[c[a]][i];
-      const double* D = model_.tet4_Dm_inv[es[l]].data();
-      for (int q = 0; q < 9; ++q) L.Dm_inv[q][l] = D[q];
-      L.V0[l] = model_.element_volume[es[l]];
-    }
-    tet4_neo_hookean_lanes(L, m);
+    tet4_lanes<N>(model_, x, es, m, L);
     double lane_dt2[N];
     tet4_stable_dt_squared_lanes(L, m, lane_dt2);
     for (int l = 0; l < N; ++l) {
@@ -164,16 +199,12 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
       } else {
         for (const Index* p = g0; p < g1; ++p) {
           const Index e = *p;
-          const NeoHookean& m = mats[mat[e]];
           const Index* c = conn + 10 * static_cast<size_t>(e);
-          Tet10Nodes xe;
-          for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
-          const Tet10Force out = tet10_internal_force(xe, model_.tet10_ref[e], m);
+          double element_dt = 0;
+          const Tet10Force out = tet10_element(model_, x, e, element_dt);
           for (int a = 0; a < 10; ++a) f_int[c[a]] += out.f.col(a);
           energy += out.energy;
-          const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
-          // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
-          dt = std::min(dt, h / m.wave_speed(out.J > 0 ? out.J : 1.0));
+          dt = std::min(dt, element_dt);
           if (worse(out.J, minJ)) {
             minJ = out.J;
             worst = e;

@@ -93,6 +93,15 @@ class ElementForces {
   mutable std::vector<Index> block_worst_;
 };
 
+/// One element's stable step at positions x, as ElementForces::compute takes
+/// it (its minimum over the elements is ElementLoopResult::stable_dt), and its
+/// det F (TET10: the smallest over its points). For diagnoses, not the loop.
+struct ElementStep {
+  double dt = 0;  ///< s, without the safety factor
+  double J = 0;
+};
+ElementStep element_stable_step(const Model& model, std::span<const Vec3> x, Index e);
+
 /// Cauchy stress of element e at positions x, averaged over its points, as 6
 /// Voigt components xx yy zz yz xz xy (Pa) written to out[0..5].
 void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e, double* out);
