@@ -1,5 +1,8 @@
 #pragma once
 // The energy and momentum ledger of a run (SCENE.md, history.csv).
+#include <algorithm>
+#include <cmath>
+
 #include "kernels/types.hpp"
 
 namespace shatter {
@@ -15,6 +18,15 @@ struct Ledger {
   /// kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work
   double total() const {
     return kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work;
+  }
+  /// The largest magnitude of the energy terms, J; NaN when one is NaN.
+  double largest() const {
+    double m = 0;
+    for (double e : {kinetic, strain, cohesive_stored, cohesive_dissipated, contact_dissipated, external_work}) {
+      if (std::isnan(e)) return e;
+      m = std::max(m, std::abs(e));
+    }
+    return m;
   }
 };
 

@@ -67,6 +67,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   share_plans();
   compute_forces(0, 0.0);
   update_ledger();
+  check_ledger();
   total0_ = ledger_.total();
   stable_dt0_ = stable_dt_;
   energy_scale_ = std::max(ledger_.kinetic + ledger_.strain, 1e-300);
@@ -130,6 +131,7 @@ void Simulation::compute_forces(long step, double time, const std::function<void
        << "); try a smaller time.safety or a finer mesh";
     throw Error(os.str());
   }
+  check_step_collapse(step, time);
   const Vec3 g = model_.scene.gravity;
   const Index n = model_.mesh.num_nodes();
   dec_->for_touched(n, [&](Index i) {
@@ -166,7 +168,7 @@ void Simulation::step() {
   ++step_;
   if (fracture_ && step_ % model_.scene.fracture_check_every == 0) apply_fracture();
   update_ledger();
-  if (!std::isfinite(ledger_.total())) throw Error(non_finite_diagnosis(model_, x_, v_, a_, ledger_, step_, time_));
+  check_ledger();
 }
 
 void Simulation::half_kick() {

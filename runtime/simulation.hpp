@@ -80,6 +80,15 @@ struct SimulationState {
 
 class Simulation {
  public:
+  /// A step collapse: the stable step below this fraction of the initial
+  /// state's (issue 21; a prescribed velocity that crushes a body took the
+  /// step down 5 orders of magnitude, and the run crawled without a word).
+  static constexpr double kStepCollapse = 1e-3;
+  /// An energy overflow: an energy term of the ledger beyond this, J (issue
+  /// 21; E = 1e308 ran into a strain energy of 5e284 J without a word). No
+  /// scene of solids holds 1e100 J (the Sun's binding energy is 7e41 J).
+  static constexpr double kEnergyOverflow = 1e100;
+
   Simulation(Model& model, RunOptions options);
   ~Simulation();
 
@@ -133,6 +142,14 @@ class Simulation {
   /// ElementForces::compute: it completes the ghost-only positions.
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
+  /// A stable step below kStepCollapse of the initial one (stable_dt0_)
+  /// throws Error naming the element that sets it, where it is and the likely
+  /// cause (simulation_checks.cpp): the run would crawl without end.
+  void check_step_collapse(long step, double time);
+  /// An energy term not finite or beyond kEnergyOverflow throws Error naming
+  /// the terms and a node (simulation_checks.cpp); in the initial state
+  /// (step 0) it is bad input, InputError.
+  void check_ledger();
   /// K sums over this rank's owned nodes of term(node, partial), each owned
   /// granule's home nodes added in plain double in node order, the granules'
   /// partial sums exactly (any thread split gives the same bits; a node costs

@@ -30,11 +30,13 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
+#include "checkpoint_failure.hpp"
 #include "scene_text.hpp"
 #include "shatter_cli.hpp"
 
 using namespace shatter;
 using shatter::test::Child;
+using shatter::test::failure_attribute;
 using shatter::test::finish;
 using shatter::test::start_shatter;
 using shatter::test::scene_from_text;
@@ -644,18 +646,6 @@ std::string failure_of(Simulation& sim, const fs::path& dir) {
     return e.what();
   }
   return "";
-}
-
-std::string failure_attribute(const fs::path& file) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  const hid_t a = H5Aopen(f, "failure", H5P_DEFAULT);
-  const hid_t t = H5Aget_type(a);
-  std::string s(H5Tget_size(t), '\0');
-  H5Aread(a, t, s.data());
-  H5Tclose(t);
-  H5Aclose(a);
-  H5Fclose(f);
-  return s.c_str();
 }
 
 }  // namespace
