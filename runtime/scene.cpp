@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "kernels/neo_hookean.hpp"
 
 namespace shatter {
 namespace {
@@ -313,6 +314,17 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     m.poisson = r.number(r.required(n, key, "poisson_ratio"), key + ".poisson_ratio");
     if (!(m.poisson > -1.0 && m.poisson < 0.5))
       r.fail(key + ".poisson_ratio", "a Poisson ratio in (-1, 0.5)", n["poisson_ratio"]);
+    // The wave speed sets the stable step: an infinite one (E = 1e308
+    // overflows lambda + 2 mu; density 1e-300) gives a step of 0, a huge one a
+    // step that never reaches time.end. No elastic wave outruns light.
+    const double c = NeoHookean::from_young_poisson(m.young, m.poisson, m.density).wave_speed();
+    if (!(c <= kMaxWaveSpeed)) {
+      std::ostringstream os;
+      os << "the dilatational wave speed sqrt((lambda + 2 mu) / density) from youngs_modulus " << m.young
+         << ", poisson_ratio " << m.poisson << " and density " << m.density << " is " << c
+         << " m/s; expected at most 3e8 m/s (the speed of light; steel's is 5.9e3 m/s)";
+      r.fail(key, os.str());
+    }
     if (const YAML::Node f = n["fracture"]) {
       const std::string fk = key + ".fracture";
       r.only_keys(f, fk, {"strength", "energy", "beta"});

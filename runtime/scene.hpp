@@ -91,6 +91,11 @@ struct Scene {
 /// load_scene and parse_scene refuse a larger one before parsing it.
 inline constexpr std::size_t kMaxSceneBytes = std::size_t{1} << 20;
 
+/// The largest dilatational wave speed of a material, m/s (the speed of
+/// light; diamond's is 1.8e4): a material beyond it is refused, since its
+/// stable step would be 0 or too small to ever reach time.end.
+inline constexpr double kMaxWaveSpeed = 3e8;
+
 /// Load and check a scene. `overrides` are "key.path=value" strings (the
 /// CLI's --set), applied to the YAML tree before checking; value is YAML.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});

@@ -715,3 +715,19 @@ TEST(FatalCondition, SweepCapDeclaredFatalStopsTheRun) {
   EXPECT_EQ(std::stol(last_row.substr(0, last_row.find(','))), s.step) << log;
   EXPECT_NE(failure_attribute(dir / "checkpoint.h5").find("DCR sweeps reached the cap"), std::string::npos);
 }
+
+// With contact.on_sweep_cap: warn (the default), the capped step's warning is
+// printed under --quiet too: --quiet hides progress, not warnings (README).
+TEST(FatalCondition, SweepCapWarningIsPrintedUnderQuiet) {
+  const fs::path dir = test_dir("warn_sweeps");
+  std::string yaml = contact_scene("warn_sweeps");
+  yaml.replace(yaml.find("time: {end: 1.0}"), 16, "time: {end: 2.0e-5}\noutput: {every: 0}");
+  yaml.replace(yaml.find("restitution: 0.5}"), 17, "restitution: 0.5, max_sweeps: 1}");
+  const std::string scene = write_scene("warn_sweeps", yaml);
+  const Child c = start_shatter({"run", scene, "--out", dir.string(), "--threads", "1", "--quiet"}, dir / "log");
+  EXPECT_EQ(finish(c), 0);
+  const std::string log = slurp(dir / "log");
+  EXPECT_NE(log.find("warning: step "), std::string::npos) << log;
+  EXPECT_NE(log.find(": DCR sweeps reached the cap (1) with penetrations left"), std::string::npos) << log;
+  EXPECT_EQ(log.find("done:"), std::string::npos) << log;
+}

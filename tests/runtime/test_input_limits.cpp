@@ -96,3 +96,33 @@ TEST(InputLimits, QuietHidesProgressNotWarnings) {
       << r.output;
   EXPECT_EQ(r.output.find("done:"), std::string::npos) << r.output;
 }
+
+// Material constants whose wave speed is infinite or beyond light's: E = 1e308
+// ran into a strain energy of 5e284 J at steps of 4e-156 s, density 1e-300 at
+// steps of 1e-159 s, both crawling without end. Refused, naming the material;
+// a soft, light material of the scaled test scenes is accepted.
+TEST(InputLimits, MaterialsFasterThanLightAreRefused) {
+  const std::string scene = write_scene("limits_material", kGood);
+  expect_refused(run_shatter("check " + scene + " --set materials.steel.youngs_modulus=1e308"),
+                 {scene + ": materials.steel: the dilatational wave speed sqrt((lambda + 2 mu) / density) from "
+                          "youngs_modulus 1e+308, poisson_ratio 0.3 and density 7850 is 1.30952e+152 m/s; expected at "
+                          "most 3e8 m/s (the speed of light; steel's is 5.9e3 m/s)"});
+  expect_refused(run_shatter("check " + scene + " --set materials.steel.density=1e-300"),
+                 {"and density 1e-300 is inf m/s; expected at most 3e8 m/s"});
+  expect_refused(run_shatter("check " + scene + " --set materials.steel.youngs_modulus=1e30"),
+                 {"is 1.30952e+13 m/s; expected at most 3e8 m/s"});
+  const auto soft = run_shatter("check " + scene +
+                                " --set materials.steel.youngs_modulus=21000 --set materials.steel.density=0.0785");
+  EXPECT_EQ(soft.status, 0) << soft.output;
+}
+
+// An initial state whose energy is already beyond Simulation::kEnergyOverflow
+// (1e100 J) is bad input: no step of it is a good state to keep.
+TEST(InputLimits, InitialEnergyBeyondOverflowIsRefused) {
+  const std::string scene = write_scene("limits_energy", kGood);
+  expect_refused(run_shatter("check " + scene + " --set 'bodies[0].initial_velocity=[1e60, 0, 0]'"),
+                 {scene + ": the initial state's energy ledger is beyond 1e+100 J (kinetic 3.925e+117, ",
+                  "the fastest node ", "has velocity (1e+60, 0, 0); expected initial velocities "
+                  "(bodies[].initial_velocity, angular_velocity, velocity_gradient, boundary_conditions[].velocity) "
+                  "and densities whose energy a run can hold"});
+}
