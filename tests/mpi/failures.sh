@@ -8,6 +8,9 @@
 #     waits in the first ledger reduction: exit 1, one error line;
 #   - every rank fails together (elements inverted by a step far above the
 #     stable one): exit 1, one error line, the last good state checkpointed;
+#   - every rank finds the stable step collapsed (a face driven at 300 m/s
+#     crushes the box): exit 1, one error line, the same as on one rank (the
+#     element with the smallest step over all ranks), a checkpoint;
 #   - bad input on every rank: exit 2, one error line.
 # A hang is caught by `timeout` (and ctest's TIMEOUT).
 # usage: failures.sh SHATTER FAIL_ALONE MPIEXEC WORKDIR
@@ -61,6 +64,13 @@ grep -q "rank 0 of 2 failed alone" "$work/lone_rank0.log" || { echo "FAIL lone_r
 run collective 1 "is inverted" "${mpi[@]}" --out "$work/collective" --set time.dt=2.0e-6 --set time.end=1.0e-3
 grep -q "the last good state (step " "$work/collective.log" && [ -f "$work/collective/checkpoint.h5" ] ||
   { echo "FAIL collective: no checkpoint of the last good state"; fail=1; }
+
+crush=(--set time.end=1.0e-4 --set "bodies[0].mesh.size=[0.01, 0.01, 0.01]" --set "bodies[0].angular_velocity=[0, 0, 0]"
+  --set "boundary_conditions=[{body: b, region: {box: [[-1, -1, -1], [-0.0049, 1, 1]]}, velocity: [300, null, null]}, {body: b, region: {box: [[0.0049, -1, -1], [1, 1, 1]]}, velocity: [0, null, null]}]")
+run collapse 1 "the stable step collapsed" "${mpi[@]}" --out "$work/collapse" "${crush[@]}"
+timeout -k 10 100 "$shatter" run "$work/box.yaml" --threads 1 --quiet --out "$work/collapse1" "${crush[@]}" > "$work/collapse1.log" 2>&1
+[ "$(grep '^error: ' "$work/collapse.log")" = "$(grep '^error: ' "$work/collapse1.log")" ] && [ -f "$work/collapse/checkpoint.h5" ] ||
+  { echo "FAIL collapse: not the message of one rank, or no checkpoint:"; cat "$work/collapse1.log"; fail=1; }
 
 run bad_input 2 "time.end: expected a positive number, got 'soon'" "${mpi[@]}" --out "$work/bad" --set time.end=soon
 exit $fail
