@@ -694,15 +694,37 @@ TEST(FatalCondition, NonFiniteLedgerStopsAtTheEndOfItsStep) {
 // contact.on_sweep_cap: fail with a cap of one sweep: the first impact stops
 // the binary with exit 1, a diagnosis naming the pair and where, and the
 // checkpoint of the step before; the history ends at that step.
-TEST(FatalCondition, SweepCapDeclaredFatalStopsTheRun) {
-  const fs::path dir = test_dir("fatal_sweeps");
-  std::string yaml = contact_scene("fatal_sweeps");
+namespace {
+
+/// The contact scene to 20 us with contact.max_sweeps: 1 and `more` contact
+/// keys, run by the binary with --quiet into test_dir(name).
+struct CappedRun {
+  std::string scene;
+  fs::path dir;
+  int status = -1;
+  std::string log;
+};
+CappedRun run_capped_contact(const std::string& name, const std::string& more) {
+  CappedRun r;
+  r.dir = test_dir(name);
+  std::string yaml = contact_scene(name);
   yaml.replace(yaml.find("time: {end: 1.0}"), 16, "time: {end: 2.0e-5}\noutput: {every: 0}");
-  yaml.replace(yaml.find("restitution: 0.5}"), 17, "restitution: 0.5, max_sweeps: 1, on_sweep_cap: fail}");
-  const std::string scene = write_scene("fatal_sweeps", yaml);
-  const Child c = start_shatter({"run", scene, "--out", dir.string(), "--threads", "1", "--quiet"}, dir / "log");
-  EXPECT_EQ(finish(c), 1);
-  const std::string log = slurp(dir / "log");
+  yaml.replace(yaml.find("restitution: 0.5}"), 17, "restitution: 0.5, max_sweeps: 1" + more + "}");
+  r.scene = write_scene(name, yaml);
+  const Child c = start_shatter({"run", r.scene, "--out", r.dir.string(), "--threads", "1", "--quiet"}, r.dir / "log");
+  r.status = finish(c);
+  r.log = slurp(r.dir / "log");
+  return r;
+}
+
+}  // namespace
+
+TEST(FatalCondition, SweepCapDeclaredFatalStopsTheRun) {
+  const CappedRun r = run_capped_contact("fatal_sweeps", ", on_sweep_cap: fail");
+  const fs::path& dir = r.dir;
+  const std::string& log = r.log;
+  const std::string& scene = r.scene;
+  EXPECT_EQ(r.status, 1);
   for (const char* part : {"DCR sweeps reached the cap (contact.max_sweeps = 1)", "still penetrating: ",
                            "pair of nodes", "('block')", "('plate')", " near (", "the last good state (step "})
     EXPECT_NE(log.find(part), std::string::npos) << part << "\n" << log;
@@ -719,14 +741,9 @@ TEST(FatalCondition, SweepCapDeclaredFatalStopsTheRun) {
 // With contact.on_sweep_cap: warn (the default), the capped step's warning is
 // printed under --quiet too: --quiet hides progress, not warnings (README).
 TEST(FatalCondition, SweepCapWarningIsPrintedUnderQuiet) {
-  const fs::path dir = test_dir("warn_sweeps");
-  std::string yaml = contact_scene("warn_sweeps");
-  yaml.replace(yaml.find("time: {end: 1.0}"), 16, "time: {end: 2.0e-5}\noutput: {every: 0}");
-  yaml.replace(yaml.find("restitution: 0.5}"), 17, "restitution: 0.5, max_sweeps: 1}");
-  const std::string scene = write_scene("warn_sweeps", yaml);
-  const Child c = start_shatter({"run", scene, "--out", dir.string(), "--threads", "1", "--quiet"}, dir / "log");
-  EXPECT_EQ(finish(c), 0);
-  const std::string log = slurp(dir / "log");
+  const CappedRun r = run_capped_contact("warn_sweeps", "");
+  const std::string& log = r.log;
+  EXPECT_EQ(r.status, 0);
   EXPECT_NE(log.find("warning: step "), std::string::npos) << log;
   EXPECT_NE(log.find(": DCR sweeps reached the cap (1) with penetrations left"), std::string::npos) << log;
   EXPECT_EQ(log.find("done:"), std::string::npos) << log;
