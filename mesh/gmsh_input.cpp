@@ -2,102 +2,12 @@
 
 #include <gmsh.h>
 
-#include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <mutex>
-#include <unordered_map>
-
 #include "kernels/error.hpp"
+#include "mesh/gmsh_model.hpp"
 
 namespace shatter {
-namespace {
-
-// The Gmsh API is one global model: serialise every use of it.
-std::mutex& gmsh_mutex() {
-  static std::mutex m;
-  return m;
-}
-
-struct GmshSession {
-  GmshSession() {
-    static bool initialized = false;
-    if (!initialized) gmsh::initialize(0, nullptr, false);
-    initialized = true;
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.Verbosity", 1);
-    gmsh::option::setNumber("General.NumThreads", 1);  // reproducible meshes
-    gmsh::clear();
-  }
-  ~GmshSession() { gmsh::clear(); }
-};
-
-// Collect the tetrahedra of the current Gmsh model (optionally one physical
-// volume) into a Mesh, renumbering nodes densely in order of first use.
-Mesh extract_tets(int order, int body, int material, const std::string& physical,
-                  const std::string& where) {
-  const int type = order == 1 ? 4 : 11;
-  const int npe = order == 1 ? 4 : 10;
-  std::vector<int> entities;
-  if (!physical.empty()) {
-    gmsh::vectorpair groups;
-    gmsh::model::getPhysicalGroups(groups, 3);
-    for (const auto& [dim, tag] : groups) {
-      std::string name;
-      gmsh::model::getPhysicalName(dim, tag, name);
-      if (name == physical) {
-        std::vector<int> ents;
-        gmsh::model::getEntitiesForPhysicalGroup(dim, tag, ents);
-        entities.insert(entities.end(), ents.begin(), ents.end());
-      }
-    }
-    if (entities.empty())
-      throw InputError(where + ": no physical volume named '" + physical + "' in the mesh file");
-  } else {
-    entities.push_back(-1);
-  }
-  Mesh mesh;
-  mesh.order = order;
-  std::unordered_map<std::size_t, Index> local;
-  std::vector<std::size_t> node_tags_all;
-  for (int ent : entities) {
-    std::vector<std::size_t> elem_tags, node_tags;
-    gmsh::model::mesh::getElementsByType(type, elem_tags, node_tags, ent);
-    for (std::size_t i = 0; i < node_tags.size(); ++i) {
-      auto [it, inserted] = local.try_emplace(node_tags[i], static_cast<Index>(local.size()));
-      if (inserted) node_tags_all.push_back(node_tags[i]);
-      mesh.conn.push_back(it->second);
-    }
-    for (std::size_t t : elem_tags) mesh.elem_gid.push_back(static_cast<GlobalId>(t));
-  }
-  if (mesh.elem_gid.empty()) {
-    int other = 0;
-    std::vector<std::size_t> et, nt;
-    gmsh::model::mesh::getElementsByType(order == 1 ? 11 : 4, et, nt);
-    other = static_cast<int>(et.size());
-    throw InputError(where + ": no " + std::to_string(npe) + "-node tetrahedra in the mesh" +
-                     (other ? " (it has " + std::to_string(npe == 4 ? 10 : 4) +
-                                  "-node ones: set mesh.order to match)"
-                            : ""));
-  }
-  mesh.reference.resize(node_tags_all.size());
-  for (std::size_t i = 0; i < node_tags_all.size(); ++i) {
-    std::vector<double> coord, param;
-    gmsh::model::mesh::getNode(node_tags_all[i], coord, param);
-    mesh.reference[i] = Vec3(coord[0], coord[1], coord[2]);
-  }
-  mesh.node_gid.assign(node_tags_all.begin(), node_tags_all.end());
-  mesh.node_body.assign(mesh.reference.size(), body);
-  mesh.elem_body.assign(mesh.elem_gid.size(), body);
-  mesh.elem_material.assign(mesh.elem_gid.size(), material);
-  mesh.build_node_elements();
-  return mesh;
-}
-
-}  // namespace
 
 Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& where) {
-  std::lock_guard lock(gmsh_mutex());
   GmshSession session;
   gmsh::model::add("shape");
   const Vec3 axis = s.axis.normalized();
@@ -149,41 +59,7 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
   gmsh::option::setNumber("Mesh.ElementOrder", s.order);
   gmsh::option::setNumber("Mesh.HighOrderOptimize", s.order == 2 ? 1 : 0);
   gmsh::model::mesh::generate(3);
-  return extract_tets(s.order, body, material, "", where);
-}
-
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material,
-              const std::string& where) {
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(where + ": mesh file '" + path + "' does not exist or is not a file");
-  // Which tetrahedra the file holds, from our own scan: Gmsh 4.8 lists a
-  // volume's tets by the type of its first one, overrunning its buffers when
-  // the volume holds two orders (docs/errors.md), so such a file never
-  // reaches Gmsh.
-  std::vector<MshElementType> tets = scan_msh_elements(path, where);
-  std::erase_if(tets, [](const MshElementType& t) { return !t.tetrahedron; });
-  if (tets.empty())
-    throw InputError(where + ": '" + path + "' holds no tetrahedra (expected 4- or 10-node tets)");
-  if (tets.size() > 1)
-    throw InputError(where + ": '" + path + "' mixes " + std::to_string(tets[0].nodes) + "- and " +
-                     std::to_string(tets[1].nodes) + "-node tetrahedra (elements " +
-                     std::to_string(tets[0].first_tag) + " and " +
-                     std::to_string(tets[1].first_tag) +
-                     "); expected tetrahedra of one order, 4- or 10-node");
-  if (tets[0].type != 4 && tets[0].type != 11)
-    throw InputError(where + ": '" + path + "' holds " + std::to_string(tets[0].nodes) +
-                     "-node tetrahedra; expected 4- or 10-node tets");
-  std::lock_guard lock(gmsh_mutex());
-  GmshSession session;
-  try {
-    gmsh::open(path);
-  } catch (...) {  // Gmsh 4.8 throws a bare value; its log holds the reason
-    std::string last;
-    gmsh::logger::getLastError(last);
-    throw InputError(where + ": Gmsh cannot read '" + path + "' as a .msh file" +
-                     (last.empty() ? "" : ": " + last));
-  }
-  return extract_tets(tets[0].type == 4 ? 1 : 2, body, material, physical, where);
+  return model_tetrahedra(selected_volumes("", where), s.order, body, material, where);
 }
 
 }  // namespace shatter

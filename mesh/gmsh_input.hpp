@@ -1,12 +1,11 @@
 #pragma once
-// Meshes through the Gmsh API: primitive shapes meshed with a target element
-// size and order, and .msh files (formats 2.x and 4.1) read by Gmsh itself after our own scan
-// of their element types.
+// Primitive shapes meshed through the Gmsh API with a target element size
+// and order. Mesh files: mesh/mesh_file.hpp.
 #include <string>
 #include <vector>
 
 #include "mesh/mesh.hpp"
-#include "mesh/msh_scan.hpp"
+#include "mesh/mesh_file.hpp"
 
 namespace shatter {
 
@@ -30,12 +29,5 @@ struct ShapeSpec {
 
 /// Mesh a primitive shape; all nodes and elements get `body` and `material`.
 Mesh mesh_shape(const ShapeSpec& spec, int body, int material, const std::string& where);
-
-/// Read the tetrahedra of a Gmsh file (all of them, or those of the physical
-/// volume named `physical` when it is not empty), as TET4 or TET10. The file
-/// is scanned first (scan_msh_elements) and refused, before Gmsh reads it,
-/// when it holds tetrahedra of more than one order.
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material,
-              const std::string& where);
 
 }  // namespace shatter

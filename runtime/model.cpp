@@ -21,7 +21,7 @@ Model build_model(const Scene& scene) {
                               (body.mesh_file.empty() ? "" : " (" + body.mesh_file + ")");
     Mesh part = body.mesh_file.empty()
                     ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
-                    : read_msh(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
+                    : read_mesh_file(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
     validate_mesh(part, where);
     if (m.mesh.num_elements() > 0 && part.order != m.mesh.order)
       throw InputError(where + ": element order " + std::to_string(part.order) +
