@@ -57,7 +57,11 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
   gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay
   gmsh::option::setNumber("Mesh.ElementOrder", s.order);
-  gmsh::option::setNumber("Mesh.HighOrderOptimize", s.order == 2 ? 1 : 0);
+  // Second-order nodes on a curved boundary can fold the elements beneath
+  // it; Gmsh's optimisation moves them until every element is valid. A box
+  // (notched or not) has flat faces only: its 10-node tets are straight.
+  const bool curved = s.shape != "box";
+  gmsh::option::setNumber("Mesh.HighOrderOptimize", s.order == 2 && curved ? 1 : 0);
   gmsh::model::mesh::generate(3);
   return model_tetrahedra(selected_volumes("", where), s.order, body, material, where);
 }
