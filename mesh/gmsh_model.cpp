@@ -23,15 +23,23 @@ bool& gmsh_initialized() {
   return initialized;
 }
 
-/// The family of a Gmsh volume element type, by the Gmsh reference
-/// manual's MSH list (asking Gmsh, getElementProperties, builds a nodal
-/// basis that Gmsh 4.8 frees wrongly for prisms: tests/fuzz/README.md).
-const char* volume_family(int type) {
+/// The family of a Gmsh volume element type (singular and plural), by the
+/// Gmsh reference manual's MSH list (asking Gmsh, getElementProperties,
+/// builds a nodal basis that Gmsh 4.8 frees wrongly for prisms:
+/// tests/fuzz/README.md); null for other types.
+struct VolumeFamily {
+  const char* one;
+  const char* many;
+};
+
+const VolumeFamily* volume_family(int type) {
+  static constexpr VolumeFamily tet{"tetrahedron", "tetrahedra"}, hex{"hexahedron", "hexahedra"},
+      prism{"prism", "prisms"}, pyramid{"pyramid", "pyramids"};
   switch (type) {
-    case 4: case 11: case 29: case 30: case 31: return "tetrahedra";
-    case 5: case 12: case 17: case 92: case 93: return "hexahedra";
-    case 6: case 13: case 18: return "prisms";
-    case 7: case 14: case 19: return "pyramids";
+    case 4: case 11: case 29: case 30: case 31: return &tet;
+    case 5: case 12: case 17: case 92: case 93: return &hex;
+    case 6: case 13: case 18: return &prism;
+    case 7: case 14: case 19: return &pyramid;
     default: return nullptr;
   }
 }
@@ -86,7 +94,7 @@ void open_in_gmsh(const std::string& path, const std::string& format, const std:
   } catch (...) {  // Gmsh 4.8 throws a bare value; its log holds the reason
     std::string last;
     gmsh::logger::getLastError(last);
-    throw InputError(where + ": Gmsh cannot read '" + path + "' as a " + format + " file" +
+    throw InputError(where + ": Gmsh cannot read '" + path + "' as " + format + " file" +
                      (last.empty() ? "" : ": " + last));
   }
 }
@@ -118,10 +126,11 @@ std::vector<int> selected_volumes(const std::string& physical, const std::string
 void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path,
                              const std::string& physical, const std::string& where) {
   struct Kind {
+    std::string one, many;
     std::size_t count = 0;
     std::set<int> volumes;
   };
-  std::map<std::string, Kind> kinds;  // by family name
+  std::map<std::string, Kind> kinds;  // by plural name
   bool others = false;
   for (int v : volumes) {
     std::vector<int> types;
@@ -129,23 +138,26 @@ void require_tetrahedra_only(const std::vector<int>& volumes, const std::string&
     for (int type : types) {
       std::vector<std::size_t> tags, nodes;
       gmsh::model::mesh::preallocateElementsByType(type, true, false, tags, nodes, v);
-      const char* family = volume_family(type);
-      Kind& k = kinds[family ? family : "elements of Gmsh type " + std::to_string(type)];
+      const VolumeFamily* family = volume_family(type);
+      const std::string other = "element of Gmsh type " + std::to_string(type);
+      const std::string many = family ? family->many : "elements of Gmsh type " + std::to_string(type);
+      Kind& k = kinds.try_emplace(many, Kind{family ? family->one : other, many, 0, {}}).first->second;
       k.count += tags.size();
       k.volumes.insert(v);
-      others = others || !family || std::string(family) != "tetrahedra";
+      others = others || many != "tetrahedra";
     }
   }
   if (!others) return;
   // Tetrahedra first, then the others by name.
   std::string held;
-  auto add = [&](const std::string& name, const Kind& k) {
+  auto add = [&](const Kind& k) {
     if (!held.empty()) held += ", ";
-    held += std::to_string(k.count) + " " + name + " (" + physical_volumes_of(k.volumes) + ")";
+    held += std::to_string(k.count) + " " + (k.count == 1 ? k.one : k.many) + " (" + physical_volumes_of(k.volumes) +
+            ")";
   };
-  if (auto t = kinds.find("tetrahedra"); t != kinds.end()) add(t->first, t->second);
+  if (auto t = kinds.find("tetrahedra"); t != kinds.end()) add(t->second);
   for (const auto& [name, k] : kinds)
-    if (name != "tetrahedra") add(name, k);
+    if (name != "tetrahedra") add(k);
   throw InputError(where + ": " + (physical.empty() ? "" : "physical volume '" + physical + "' of ") + "'" + path +
                    "' holds " + held +
                    "; expected tetrahedra only: name a physical volume of tetrahedra only with mesh.physical, or "

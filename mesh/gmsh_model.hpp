@@ -28,7 +28,7 @@ class GmshSession {
 
 /// Open a mesh file into the model (Gmsh picks the reader by extension).
 /// A file Gmsh cannot read throws InputError naming `where`, the file, the
-/// format it was read as (`format`, e.g. ".msh") and Gmsh's last error.
+/// format it was read as (`format`, with its article: "a .msh") and Gmsh's last error.
 void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where);
 
 /// The volumes (3D entity tags) of the physical volume named `physical`, or

@@ -1,6 +1,5 @@
 #include "mesh/mesh_file.hpp"
 
-#include <gmsh.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +8,7 @@
 #include <filesystem>
 
 #include "kernels/error.hpp"
+#include "mesh/gmsh_convert.hpp"
 #include "mesh/gmsh_model.hpp"
 
 namespace shatter {
@@ -63,12 +63,12 @@ std::string lower_extension(const std::string& path) {
 }  // namespace
 
 const std::vector<MeshFileFormat>& mesh_file_formats() {
-  static const std::vector<MeshFileFormat> formats = {{".msh", "Gmsh .msh (format 2.2 or 4.1)"},
-                                                      {".unv", "I-deas universal"},
-                                                      {".vtk", "legacy VTK"},
-                                                      {".mesh", "Medit"},
-                                                      {".bdf", "Nastran bulk data"},
-                                                      {".nas", "Nastran bulk data"}};
+  static const std::vector<MeshFileFormat> formats = {{".msh", "a .msh"},
+                                                      {".unv", "an I-deas universal"},
+                                                      {".vtk", "a legacy VTK"},
+                                                      {".mesh", "a Medit"},
+                                                      {".bdf", "a Nastran bulk data"},
+                                                      {".nas", "a Nastran bulk data"}};
   return formats;
 }
 
@@ -81,7 +81,7 @@ Mesh read_msh(const std::string& path, const std::string& physical, int body, in
   // reaches Gmsh.
   const int order = tetrahedron_order(scan_msh_elements(path, where), path, where);
   GmshSession session;
-  open_in_gmsh(path, ".msh", where);
+  open_in_gmsh(path, "a .msh", where);
   return tetrahedra_of_model(order, path, physical, body, material, where);
 }
 
@@ -100,24 +100,16 @@ Mesh read_mesh_file(const std::string& path, const std::string& physical, int bo
   }
   require_file(path, where);
   GmshSession session;
-  open_in_gmsh(path, format->name, where);
   // The model as Gmsh writes it (binary .msh 4.1, every element, one block
   // per volume and element type, whatever the types of its first elements),
-  // scanned as a user's .msh is: the same refusals, before any element of
-  // the model is listed.
+  // read as a user's .msh is: scanned first, the same refusals, before Gmsh
+  // lists any element; messages name the user's file.
   static std::atomic<unsigned> serial{0};
   const TemporaryFile copy{std::filesystem::temp_directory_path() /
                            ("shatter_mesh_" + std::to_string(getpid()) + "_" + std::to_string(serial++) + ".msh")};
-  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
-  gmsh::option::setNumber("Mesh.Binary", 1);
-  gmsh::option::setNumber("Mesh.SaveAll", 1);
-  try {
-    gmsh::write(copy.path.string());
-  } catch (...) {
-    throw Error(where + ": cannot write the temporary copy '" + copy.path.string() + "' of '" + path +
-                "' (is the temporary folder writable?)");
-  }
+  convert_to_msh_in_child(path, format->name, copy.path.string(), where);
   const int order = tetrahedron_order(scan_msh_elements(copy.path.string(), where, path), path, where);
+  open_in_gmsh(copy.path.string(), "a .msh", where);
   return tetrahedra_of_model(order, path, physical, body, material, where);
 }
 

@@ -11,7 +11,7 @@
 namespace shatter {
 
 /// A mesh file format shatter reads: its extension (lower case, with the
-/// dot) and what it is.
+/// dot) and what it is, with its article ("an I-deas universal" file).
 struct MeshFileFormat {
   const char* extension;
   const char* name;

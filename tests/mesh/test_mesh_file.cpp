@@ -6,33 +6,20 @@
 
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <string>
 
 #include "expect_close.hpp"
 #include "kernels/error.hpp"
 #include "mesh/gmsh_model.hpp"
 #include "mesh/mesh_file.hpp"
+#include "mesh/mesh_test_helpers.hpp"
 
 using namespace shatter;
+using shatter::test::input_error;
+using shatter::test::total_volume;
 namespace fs = std::filesystem;
 
 namespace {
-
-double total_volume(const Mesh& m) {
-  double v = 0;
-  for (Index e = 0; e < m.num_elements(); ++e) v += element_reference_volume(m, e);
-  return v;
-}
-
-std::string input_error(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(SHATTER_BINARY_DIR "/test_scratch") / name;
@@ -151,6 +138,28 @@ TEST(MeshFile, OtherFilesAreRefusedAndGmshRecovers) {
   const std::string why = input_error([&] { read_mesh_file(garbage, "", 0, 0, "w"); });
   EXPECT_EQ(why.rfind("w: Gmsh cannot read '" + garbage + "' as a legacy VTK file", 0), 0u) << why;
   EXPECT_GT(read_mesh_file((dir / "ascii.vtk").string(), "", 0, 0, "w").num_elements(), 300);
+  // A .msh file that passes our scan of its elements but not Gmsh's reading
+  // of its nodes: after Gmsh's failure, the next file reads in full.
+  const std::string bad_nodes = (dir / "bad_nodes.msh").string();
+  std::ofstream(bad_nodes) << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 x\n$EndNodes\n"
+                              "$Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n";
+  const std::string nodes_why = input_error([&] { read_mesh_file(bad_nodes, "", 0, 0, "w"); });
+  EXPECT_EQ(nodes_why.rfind("w: Gmsh cannot read '" + bad_nodes + "' as a .msh file", 0), 0u) << nodes_why;
+  EXPECT_GT(read_mesh_file((dir / "v41_ascii.msh").string(), "", 0, 0, "w").num_elements(), 300);
+  // Files on which Gmsh 4.8's readers crash (found by fuzz_mesh_file; the
+  // first byte there picks the format): the child process that read them
+  // dies, shatter refuses the file, and the next file reads.
+  for (const auto& [crash, format] : {std::pair{"unv_element_line_missing.unv", "an I-deas universal"},
+                                      std::pair{"vtk_cell_node_out_of_range.vtk", "a legacy VTK"}}) {
+    std::ifstream in(fs::path(SHATTER_SOURCE_DIR) / "tests/fuzz/crashes/mesh_file" / crash, std::ios::binary);
+    in.get();
+    const std::string file = (dir / crash).string();
+    std::ofstream(file, std::ios::binary) << in.rdbuf();
+    const std::string crashed = input_error([&] { read_mesh_file(file, "", 0, 0, "w"); });
+    EXPECT_EQ(crashed.rfind("w: Gmsh crashed reading '" + file + "' as " + format + " file (", 0), 0u) << crashed;
+    EXPECT_NE(crashed.find("); expected a well-formed file of that format"), std::string::npos) << crashed;
+    EXPECT_GT(read_mesh_file((dir / "ideas.unv").string(), "", 0, 0, "w").num_elements(), 300);
+  }
   // A surface mesh in a format that also holds volumes.
   const std::string surface = (dir / "surface.vtk").string();
   std::ofstream(surface) << "# vtk DataFile Version 2.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n"
