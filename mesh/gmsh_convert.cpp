@@ -51,7 +51,8 @@ enum ChildStatus { kConverted = 0, kUnreadable = 3, kUnwritable = 4 };
 void convert_to_msh_in_child(const std::string& path, const std::string& format, const std::string& copy,
                              const std::string& where) {
   int pipe_fds[2];
-  if (pipe(pipe_fds) != 0) throw Error(where + ": cannot create a pipe to convert '" + path + "': " + std::strerror(errno));
+  if (pipe(pipe_fds) != 0)
+    throw Error(where + ": cannot create a pipe to convert '" + path + "': " + std::strerror(errno));
   std::fflush(nullptr);  // the child must not write the parent's buffered output again
   const pid_t pid = fork();
   if (pid < 0) {
@@ -80,9 +81,9 @@ void convert_to_msh_in_child(const std::string& path, const std::string& format,
   if (code == kUnreadable) throw InputError(message);
   if (code == kUnwritable) throw Error(message);
   // A signal, or (under a sanitizer) the sanitizer's exit status.
-  const std::string how = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) + ", " +
-                                                    strsignal(WTERMSIG(status))
-                                              : "exit status " + std::to_string(code);
+  const std::string how = WIFSIGNALED(status)
+                              ? "signal " + std::to_string(WTERMSIG(status)) + ", " + strsignal(WTERMSIG(status))
+                              : "exit status " + std::to_string(code);
   throw InputError(where + ": Gmsh crashed reading '" + path + "' as " + format + " file (" + how +
                    "); expected a well-formed file of that format");
 }

@@ -36,11 +36,28 @@ const VolumeFamily* volume_family(int type) {
   static constexpr VolumeFamily tet{"tetrahedron", "tetrahedra"}, hex{"hexahedron", "hexahedra"},
       prism{"prism", "prisms"}, pyramid{"pyramid", "pyramids"};
   switch (type) {
-    case 4: case 11: case 29: case 30: case 31: return &tet;
-    case 5: case 12: case 17: case 92: case 93: return &hex;
-    case 6: case 13: case 18: return &prism;
-    case 7: case 14: case 19: return &pyramid;
-    default: return nullptr;
+    case 4:
+    case 11:
+    case 29:
+    case 30:
+    case 31:
+      return &tet;
+    case 5:
+    case 12:
+    case 17:
+    case 92:
+    case 93:
+      return &hex;
+    case 6:
+    case 13:
+    case 18:
+      return &prism;
+    case 7:
+    case 14:
+    case 19:
+      return &pyramid;
+    default:
+      return nullptr;
   }
 }
 
@@ -118,13 +135,12 @@ std::vector<int> selected_volumes(const std::string& physical, const std::string
       volumes.insert(volumes.end(), ents.begin(), ents.end());
     }
   }
-  if (volumes.empty())
-    throw InputError(where + ": no physical volume named '" + physical + "' in the mesh file");
+  if (volumes.empty()) throw InputError(where + ": no physical volume named '" + physical + "' in the mesh file");
   return volumes;
 }
 
-void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path,
-                             const std::string& physical, const std::string& where) {
+void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path, const std::string& physical,
+                             const std::string& where) {
   struct Kind {
     std::string one, many;
     std::size_t count = 0;
@@ -152,8 +168,8 @@ void require_tetrahedra_only(const std::vector<int>& volumes, const std::string&
   std::string held;
   auto add = [&](const Kind& k) {
     if (!held.empty()) held += ", ";
-    held += std::to_string(k.count) + " " + (k.count == 1 ? k.one : k.many) + " (" + physical_volumes_of(k.volumes) +
-            ")";
+    held +=
+        std::to_string(k.count) + " " + (k.count == 1 ? k.one : k.many) + " (" + physical_volumes_of(k.volumes) + ")";
   };
   if (auto t = kinds.find("tetrahedra"); t != kinds.end()) add(t->second);
   for (const auto& [name, k] : kinds)
@@ -184,9 +200,9 @@ Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int 
   if (mesh.elem_gid.empty()) {
     std::vector<std::size_t> et, nt;
     gmsh::model::mesh::getElementsByType(order == 1 ? 11 : 4, et, nt);
-    throw InputError(where + ": no " + std::to_string(npe) + "-node tetrahedra in the mesh" +
-                     (et.empty() ? "" : " (it has " + std::to_string(npe == 4 ? 10 : 4) +
-                                            "-node ones: set mesh.order to match)"));
+    throw InputError(
+        where + ": no " + std::to_string(npe) + "-node tetrahedra in the mesh" +
+        (et.empty() ? "" : " (it has " + std::to_string(npe == 4 ? 10 : 4) + "-node ones: set mesh.order to match)"));
   }
   mesh.reference.resize(node_tags_all.size());
   for (std::size_t i = 0; i < node_tags_all.size(); ++i) {

@@ -40,13 +40,12 @@ std::vector<int> selected_volumes(const std::string& physical, const std::string
 /// prisms, pyramids, ...): an InputError naming the file, each kind's count
 /// and the physical volumes holding it. Counts come from Gmsh's per-family
 /// sizes (preallocateElementsByType), which read no element's nodes.
-void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path,
-                             const std::string& physical, const std::string& where);
+void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path, const std::string& physical,
+                             const std::string& where);
 
 /// The tetrahedra of `order` (1: 4-node, 2: 10-node) in `volumes`, as a Mesh
 /// whose nodes are renumbered densely in order of first use; ids are Gmsh's
 /// tags. InputError when there are none.
-Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int material,
-                      const std::string& where);
+Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int material, const std::string& where);
 
 }  // namespace shatter

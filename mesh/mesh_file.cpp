@@ -23,8 +23,7 @@ void require_file(const std::string& path, const std::string& where) {
 /// scan of `path`); InputError when there is none, two, or one of order > 2.
 int tetrahedron_order(std::vector<MshElementType> types, const std::string& path, const std::string& where) {
   std::erase_if(types, [](const MshElementType& t) { return !t.tetrahedron; });
-  if (types.empty())
-    throw InputError(where + ": '" + path + "' holds no tetrahedra (expected 4- or 10-node tets)");
+  if (types.empty()) throw InputError(where + ": '" + path + "' holds no tetrahedra (expected 4- or 10-node tets)");
   if (types.size() > 1)
     throw InputError(where + ": '" + path + "' mixes " + std::to_string(types[0].nodes) + "- and " +
                      std::to_string(types[1].nodes) + "-node tetrahedra (elements " +
@@ -63,17 +62,13 @@ std::string lower_extension(const std::string& path) {
 }  // namespace
 
 const std::vector<MeshFileFormat>& mesh_file_formats() {
-  static const std::vector<MeshFileFormat> formats = {{".msh", "a .msh"},
-                                                      {".unv", "an I-deas universal"},
-                                                      {".vtk", "a legacy VTK"},
-                                                      {".mesh", "a Medit"},
-                                                      {".bdf", "a Nastran bulk data"},
-                                                      {".nas", "a Nastran bulk data"}};
+  static const std::vector<MeshFileFormat> formats = {
+      {".msh", "a .msh"},   {".unv", "an I-deas universal"}, {".vtk", "a legacy VTK"},
+      {".mesh", "a Medit"}, {".bdf", "a Nastran bulk data"}, {".nas", "a Nastran bulk data"}};
   return formats;
 }
 
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material,
-              const std::string& where) {
+Mesh read_msh(const std::string& path, const std::string& physical, int body, int material, const std::string& where) {
   require_file(path, where);
   // Which tetrahedra the file holds, from our own scan: Gmsh 4.8 lists a
   // volume's tets by the type of its first one, overrunning its buffers when
@@ -90,8 +85,8 @@ Mesh read_mesh_file(const std::string& path, const std::string& physical, int bo
   const std::string ext = lower_extension(path);
   if (ext == ".msh") return read_msh(path, physical, body, material, where);
   const auto& formats = mesh_file_formats();
-  const auto format = std::find_if(formats.begin(), formats.end(),
-                                   [&](const MeshFileFormat& f) { return ext == f.extension; });
+  const auto format =
+      std::find_if(formats.begin(), formats.end(), [&](const MeshFileFormat& f) { return ext == f.extension; });
   if (format == formats.end()) {
     std::string list;
     for (const MeshFileFormat& f : formats) list += std::string(list.empty() ? "" : ", ") + f.extension;

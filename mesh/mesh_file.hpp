@@ -36,7 +36,6 @@ Mesh read_mesh_file(const std::string& path, const std::string& physical, int bo
 /// tetrahedra of more than one order; volumes holding other elements than
 /// tetrahedra (prisms, hexahedra, pyramids) are refused, naming each kind's
 /// count and physical volumes, never dropped.
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material,
-              const std::string& where);
+Mesh read_msh(const std::string& path, const std::string& physical, int body, int material, const std::string& where);
 
 }  // namespace shatter

@@ -23,9 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const int format = pick ? int(pick - kLetters) : data[0] % 5;
   // One file per process and format: Gmsh reads by path and picks the
   // reader by the extension.
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("shatter_fuzz_" + std::to_string(getpid()) + kExtensions[format]))
-                               .string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("shatter_fuzz_" + std::to_string(getpid()) + kExtensions[format]))
+          .string();
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));

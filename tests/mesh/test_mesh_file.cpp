@@ -39,10 +39,17 @@ struct Variant {
 
 // Nastran: small fields (Gmsh's default) and free fields keep 6 decimals of
 // each coordinate, large fields 8 significant digits.
-const std::vector<Variant> kVariants = {
-    {"v41_ascii.msh"},     {"v41_binary.msh", 1}, {"v22_ascii.msh", 0, 2.2}, {"v22_binary.msh", 1, 2.2},
-    {"ideas.unv"},         {"ascii.vtk"},         {"binary.vtk", 1},         {"medit.mesh"},
-    {"small_field.bdf", 0, 4.1, 1, 3e-5}, {"free_field.nas", 0, 4.1, 0, 3e-5}, {"large_field.bdf", 0, 4.1, 2, 1e-9}};
+const std::vector<Variant> kVariants = {{"v41_ascii.msh"},
+                                        {"v41_binary.msh", 1},
+                                        {"v22_ascii.msh", 0, 2.2},
+                                        {"v22_binary.msh", 1, 2.2},
+                                        {"ideas.unv"},
+                                        {"ascii.vtk"},
+                                        {"binary.vtk", 1},
+                                        {"medit.mesh"},
+                                        {"small_field.bdf", 0, 4.1, 1, 3e-5},
+                                        {"free_field.nas", 0, 4.1, 0, 3e-5},
+                                        {"large_field.bdf", 0, 4.1, 2, 1e-9}};
 
 /// A cylinder (radius 0.5, length 1) minus a coaxial hole (radius 0.2):
 /// curved faces outside and in, one physical volume 'body'. Written by Gmsh
@@ -237,8 +244,9 @@ TEST(MeshFile, TetsMixedWithPrismsAreRefusedNotTruncated) {
   const TetsAndPrisms f = write_tets_and_prisms();
   ASSERT_GT(f.tets, 100u);
   ASSERT_GT(f.prisms, 100u);
-  const std::string tail = "; expected tetrahedra only: name a physical volume of tetrahedra only with "
-                           "mesh.physical, or mesh the body with tetrahedra";
+  const std::string tail =
+      "; expected tetrahedra only: name a physical volume of tetrahedra only with "
+      "mesh.physical, or mesh the body with tetrahedra";
   EXPECT_EQ(input_error([&] { read_mesh_file(f.msh, "", 0, 0, "w"); }),
             "w: '" + f.msh + "' holds " + std::to_string(f.tets) + " tetrahedra (physical volume 'core'), " +
                 std::to_string(f.prisms) + " prisms (physical volume 'layers')" + tail);
