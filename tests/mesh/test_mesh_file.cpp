@@ -262,3 +262,23 @@ TEST(MeshFile, TetsMixedWithPrismsAreRefusedNotTruncated) {
             "w: '" + f.vtk + "' holds " + std::to_string(f.tets) + " tetrahedra (in no physical volume), " +
                 std::to_string(f.prisms) + " prisms (in no physical volume)" + tail);
 }
+
+// Every kind of volume element is named: a tet in physical volume 'tets', a
+// hexahedron (the unit cube) and a pyramid on its top face in 'bricks'.
+TEST(MeshFile, HexahedraAndPyramidsAreNamedToo) {
+  const std::string f = (scratch("mesh_file_mixed") / "bricks.msh").string();
+  std::ofstream(f) << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                      "$PhysicalNames\n2\n3 1 \"tets\"\n3 2 \"bricks\"\n$EndPhysicalNames\n"
+                      "$Nodes\n10\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n"
+                      "9 0.5 0.5 1.5\n10 0 0 -1\n$EndNodes\n"
+                      "$Elements\n3\n1 4 2 1 1 1 4 2 10\n2 5 2 2 2 1 2 3 4 5 6 7 8\n3 7 2 2 2 5 6 7 8 9\n"
+                      "$EndElements\n";
+  EXPECT_EQ(input_error([&] { read_mesh_file(f, "", 0, 0, "w"); }),
+            "w: '" + f +
+                "' holds 1 tetrahedron (physical volume 'tets'), 1 hexahedron (physical volume 'bricks'), 1 pyramid "
+                "(physical volume 'bricks'); expected tetrahedra only: name a physical volume of tetrahedra only "
+                "with mesh.physical, or mesh the body with tetrahedra");
+  const Mesh tets = read_mesh_file(f, "tets", 0, 0, "w");
+  EXPECT_EQ(tets.num_elements(), 1);
+  EXPECT_CLOSE(total_volume(tets), 1.0 / 6.0, 1e-14, 0);
+}
