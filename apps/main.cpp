@@ -21,9 +21,13 @@
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/failure.hpp"
+#include "runtime/disk_reserve.hpp"
 #include "runtime/model.hpp"
+#include "runtime/output_folder.hpp"
 #include "runtime/report.hpp"
+#include "runtime/restart_check.hpp"
 #include "runtime/scene.hpp"
+#include "runtime/setup_stop.hpp"
 #include "runtime/simulation.hpp"
 
 using namespace shatter;
@@ -87,24 +91,6 @@ int plot_outputs(const std::string& out_dir) {
   return WEXITSTATUS(wstatus);
 }
 
-/// The one message of a failure and the exit status (runtime/failure.hpp):
-/// when every rank failed, rank 0 prints it; a rank that failed alone prints
-/// it and ends every rank with MPI_Abort.
-int report_failure(FailureChannel& failures, int status, const char* message, int rank, int ranks) {
-  const FailureAgreement a = failures.agree(status);
-  if (!a.all_ranks) {
-    std::fprintf(stderr,
-                 "error: %s\n(rank %d of %d failed alone while the others waited in a collective: "
-                 "every rank is ended with MPI_Abort; no checkpoint of this failure, an earlier "
-                 "one stays)\n",
-                 message, rank, ranks);
-    std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, status);
-  }
-  if (rank == 0) std::fprintf(stderr, "error: %s\n", message);
-  return a.status;
-}
-
 int cli(int argc, char** argv, FailureChannel& failures) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -148,21 +134,26 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (*plot) return rank == 0 ? plot_outputs(out_dir) : 0;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     const Scene scene = load_scene(scene_path, overrides);
-    model = build_model(scene);
     RunOptions opt;
     opt.threads = threads;
     opt.ranks = ranks;
     opt.quiet = quiet;
     opt.deterministic = deterministic;
     opt.failures = &failures;
-    if (const char* fail = std::getenv("SHATTER_TEST_FAIL"))
-      if (std::sscanf(fail, "%d:%ld", &opt.fail_rank, &opt.fail_step) != 2)
-        throw InputError(std::string("SHATTER_TEST_FAIL=") + fail + ": expected RANK:STEP");
     if (*run) opt.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.name : std::filesystem::path(out_dir);
     // A restart continues the outputs beside its checkpoint unless --out says otherwise.
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
+    // Before the meshing: a folder that cannot take the outputs is bad input.
+    if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
+    model = build_model(scene);
     sim = std::make_unique<Simulation>(*model, opt);
-    if (!restart.empty()) sim->restore_state(read_checkpoint(restart, *model));
+    if (!restart.empty()) {
+      CheckpointRun written;
+      SimulationState state = read_checkpoint(restart, *model, &written);
+      // Before run() cuts the rows after the checkpoint: a refused restart touches nothing.
+      on_root_for_all(MPI_COMM_WORLD, [&] { check_restart(restart, state, written, scene, opt.out_dir); });
+      sim->restore_state(state);
+    }
     if (*check) {
       print_check(*model, *sim);
     } else {
@@ -173,9 +164,9 @@ int cli(int argc, char** argv, FailureChannel& failures) {
                      sim->energy_error(), opt.out_dir.c_str());
     }
   } catch (const InputError& e) {
-    return report_failure(failures, 2, e.what(), rank, ranks);
+    return report_failure(failures, 2, e.what());
   } catch (const std::exception& e) {
-    return report_failure(failures, 1, e.what(), rank, ranks);
+    return report_failure(failures, 1, e.what());
   }
   return 0;
 }
@@ -183,13 +174,19 @@ int cli(int argc, char** argv, FailureChannel& failures) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_setup_stop_handlers();
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  set_setup_stop_rank(rank);
+  install_setup_stop_handlers();
   int status = 0;
   {
     FailureChannel failures(MPI_COMM_WORLD);
     status = cli(argc, argv, failures);
   }
+  release_disk_space();
   MPI_Finalize();
   return status;
 }

@@ -31,8 +31,8 @@ Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Inde
 }
 
 std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
-                                   std::span<const double> stress, int stress_size,
-                                   FractureLaws laws) {
+                                   std::span<const double> stress, int stress_size, FractureLaws laws,
+                                   std::span<const Index> local, std::span<const Index> owned) {
   SHATTER_REQUIRE(stress_size == 6 || stress_size == 9,
                   "critical_facets: stress_size must be 6 or 9, got " << stress_size);
   SHATTER_REQUIRE(stress.size() >= static_cast<size_t>(mesh.num_elements()) * stress_size,
@@ -53,23 +53,28 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   // if one of its elements is "hot": |sigma_e|_F max(1, 1/beta) >= sigma_c.
   // Pass 1 computes the norms (one contiguous, vectorisable sweep); pass 2
   // visits the facets of hot elements only. The factor 1 + 1e-12 keeps the
-  // bound safe against the round-off of the norms.
+  // bound safe against the round-off of the norms. Both passes cover the
+  // local elements (all on one rank).
   constexpr double kSafe = 1.0 + 1e-12;
-  std::unique_ptr<double[]> frobenius(new double[ne]);
+  const bool all = local.empty();
+  const Index nlocal = all ? ne : static_cast<Index>(local.size());
+  auto elem = [&](Index k) { return all ? k : local[k]; };
+  auto is_owned = [&](Index e) { return owned.empty() || std::binary_search(owned.begin(), owned.end(), e); };
+  std::unique_ptr<double[]> frobenius(new double[ne]);  // set for the local elements
   const double* s = stress.data();
-  tbb::parallel_for(tbb::blocked_range<Index>(0, ne, 4096), [&](const tbb::blocked_range<Index>& r) {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 4096), [&](const tbb::blocked_range<Index>& r) {
     if (stress_size == 6) {
-      for (Index e = r.begin(); e != r.end(); ++e) {
-        const double* v = s + 6 * static_cast<size_t>(e);
-        frobenius[e] = kSafe * std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] +
-                                         2.0 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]));
+      for (Index k = r.begin(); k != r.end(); ++k) {
+        const double* v = s + 6 * static_cast<size_t>(elem(k));
+        frobenius[elem(k)] = kSafe * std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] +
+                                               2.0 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]));
       }
     } else {
-      for (Index e = r.begin(); e != r.end(); ++e) {
-        const double* v = s + 9 * static_cast<size_t>(e);
+      for (Index k = r.begin(); k != r.end(); ++k) {
+        const double* v = s + 9 * static_cast<size_t>(elem(k));
         double sum = 0;
         for (int i = 0; i < 9; ++i) sum += v[i] * v[i];
-        frobenius[e] = kSafe * std::sqrt(sum);
+        frobenius[elem(k)] = kSafe * std::sqrt(sum);
       }
     }
   });
@@ -78,15 +83,18 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   // local id; facets found by any thread are gathered and sorted by global
   // id, so the result does not depend on the threads.
   tbb::enumerable_thread_specific<std::vector<Index>> found;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, ne, 1024), [&](const tbb::blocked_range<Index>& r) {
-    std::vector<Index>* local = nullptr;
-    for (Index e = r.begin(); e != r.end(); ++e) {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 1024), [&](const tbb::blocked_range<Index>& r) {
+    std::vector<Index>* local_found = nullptr;
+    for (Index k = r.begin(); k != r.end(); ++k) {
+      const Index e = elem(k);
       if (frobenius[e] < hot) continue;
       for (int i = 0; i < 4; ++i) {
         const Index f = topo.elem_facet[4 * static_cast<size_t>(e) + i];
         if (topo.facet_state[f] != FacetState::intact) continue;  // boundary, cohesive or free
         const auto [e0, e1] = topo.facet_elem[f];
         const Index other = e0 == e ? e1 : e0;
+        // The owner of the smaller element checks the facet (then both are local).
+        if (!is_owned(std::min(e, other))) continue;
         if (other < e && frobenius[other] >= hot) continue;  // evaluated from `other`
         const CohesiveLaw* law = facet_law(mesh, topo, laws, f);
         if (!law) continue;
@@ -97,8 +105,8 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         const Mat3 sigma = 0.5 * (element_cauchy_stress(stress, stress_size, e0) +
                                   element_cauchy_stress(stress, stress_size, e1));
         if (facet_effective_traction(sigma, n, law->beta) >= law->sigma_c) {
-          if (!local) local = &found.local();
-          local->push_back(f);
+          if (!local_found) local_found = &found.local();
+          local_found->push_back(f);
         }
       }
     }

@@ -30,8 +30,14 @@ Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Inde
 /// `x` (m, per node). Evaluated with oneTBB; the result (local facet ids) is
 /// sorted by Topology::facet_gid, the canonical insertion order, and does not
 /// depend on the number of threads.
+///
+/// On MPI ranks: `local` (ascending) lists the elements whose stresses are
+/// current (owned and ghost), `owned` (ascending, within `local`) those the
+/// rank owns; only the facets whose element of smaller index is owned are
+/// checked (each facet by one rank; both its elements are local). Empty
+/// lists: every element, on one rank.
 std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
-                                   std::span<const double> stress, int stress_size,
-                                   FractureLaws laws);
+                                   std::span<const double> stress, int stress_size, FractureLaws laws,
+                                   std::span<const Index> local = {}, std::span<const Index> owned = {});
 
 }  // namespace shatter

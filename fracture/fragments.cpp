@@ -29,8 +29,7 @@ double current_volume(const Mesh& mesh, std::span<const Vec3> x, Index e) {
 
 }  // namespace
 
-Fragments find_fragments(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
-                         std::span<const Vec3> v, std::span<const double> mass) {
+Fragments label_fragments(const Mesh& mesh, const Topology& topo) {
   const Index ne = mesh.num_elements();
   std::vector<Index> parent(ne);
   std::iota(parent.begin(), parent.end(), 0);
@@ -55,26 +54,53 @@ Fragments find_fragments(const Mesh& mesh, const Topology& topo, std::span<const
   for (size_t i = 0; i < roots.size(); ++i) root_id[roots[i]] = static_cast<Index>(i);
 
   Fragments out;
+  out.fragments = static_cast<Index>(roots.size());
   out.elem_fragment.resize(ne);
-  out.stats.resize(roots.size());
-  for (Index e = 0; e < ne; ++e) {
-    const Index id = root_id[find_root(parent, e)];
-    out.elem_fragment[e] = id;
-    out.stats[id].elements += 1;
-    out.stats[id].volume += current_volume(mesh, x, e);
+  for (Index e = 0; e < ne; ++e) out.elem_fragment[e] = root_id[find_root(parent, e)];
+  return out;
+}
+
+std::vector<ExactSum> fragment_sums(const Mesh& mesh, const Fragments& frags, std::span<const Index> nodes,
+                                    std::span<const Index> elements, std::span<const Vec3> x,
+                                    std::span<const Vec3> v, std::span<const double> mass) {
+  std::vector<ExactSum> sums(static_cast<size_t>(frags.count()) * kFragmentSums);
+  for (const Index e : elements) {
+    ExactSum* s = sums.data() + static_cast<size_t>(frags.elem_fragment[e]) * kFragmentSums;
+    s[7] += current_volume(mesh, x, e);
+    s[8] += 1.0;
   }
-  for (Index n = 0; n < mesh.num_nodes(); ++n) {
+  for (const Index n : nodes) {
     if (mesh.node_elem_offsets[n + 1] == mesh.node_elem_offsets[n]) continue;
-    FragmentStats& s = out.stats[out.elem_fragment[mesh.node_elem[mesh.node_elem_offsets[n]]]];
-    s.mass += mass[n];
-    s.centre += mass[n] * x[n];
-    s.velocity += mass[n] * v[n];
+    ExactSum* s =
+        sums.data() + static_cast<size_t>(frags.elem_fragment[mesh.node_elem[mesh.node_elem_offsets[n]]]) * kFragmentSums;
+    s[0] += mass[n];
+    for (int c = 0; c < 3; ++c) s[1 + c] += mass[n] * x[n][c], s[4 + c] += mass[n] * v[n][c];
   }
-  for (FragmentStats& s : out.stats)
-    if (s.mass > 0) {
-      s.centre /= s.mass;
-      s.velocity /= s.mass;
+  return sums;
+}
+
+void set_fragment_stats(Fragments& frags, std::span<const ExactSum> sums) {
+  frags.stats.assign(frags.count(), FragmentStats{});
+  for (Index k = 0; k < frags.count(); ++k) {
+    const ExactSum* s = sums.data() + static_cast<size_t>(k) * kFragmentSums;
+    FragmentStats& st = frags.stats[k];
+    st.mass = s[0].value();
+    st.volume = s[7].value();
+    st.elements = static_cast<Index>(s[8].value());
+    if (st.mass > 0) {
+      st.centre = Vec3(s[1].value(), s[2].value(), s[3].value()) / st.mass;
+      st.velocity = Vec3(s[4].value(), s[5].value(), s[6].value()) / st.mass;
     }
+  }
+}
+
+Fragments find_fragments(const Mesh& mesh, const Topology& topo, std::span<const Vec3> x,
+                         std::span<const Vec3> v, std::span<const double> mass) {
+  Fragments out = label_fragments(mesh, topo);
+  std::vector<Index> nodes(mesh.num_nodes()), elements(mesh.num_elements());
+  std::iota(nodes.begin(), nodes.end(), 0);
+  std::iota(elements.begin(), elements.end(), 0);
+  set_fragment_stats(out, fragment_sums(mesh, out, nodes, elements, x, v, mass));
   return out;
 }
 

@@ -93,7 +93,22 @@ std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, 
   const int status = METIS_PartGraphKway(&nv, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr,
                                          adjwgt.data(), &nparts, nullptr, nullptr, options, &edgecut, part.data());
   SHATTER_REQUIRE(status == METIS_OK, "partition_granules: METIS_PartGraphKway failed with status " << status);
-  return std::vector<int>(part.begin(), part.end());
+  // With few granules per part METIS may leave a part empty (6 granules in 4
+  // parts): each empty part takes the last granule of the part with the most
+  // (the first such part), so every rank has work; deterministic like METIS.
+  std::vector<int> out(part.begin(), part.end());
+  std::vector<Index> count(parts, 0);
+  for (int p : out) ++count[p];
+  for (int p = 0; p < parts; ++p) {
+    if (count[p] > 0) continue;
+    const int big = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());
+    Index g = ng - 1;
+    while (out[g] != big) --g;
+    out[g] = p;
+    --count[big];
+    ++count[p];
+  }
+  return out;
 }
 
 std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed) {

@@ -27,7 +27,8 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts, int seed = 1);
 /// graph, two granules adjacent when they share nodes, edge weight = number
 /// of shared nodes, vertex weight = elements; seeded like partition_elements,
 /// so every rank computing it gets the same answer. Needs the node -> element
-/// CSR. For parts = 1 all zeros. Throws Error when parts < 1 or parts > granules.
+/// CSR. For parts = 1 all zeros. No part is empty (a part METIS leaves empty
+/// takes a granule of the largest). Throws Error when parts < 1 or parts > granules.
 std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed = 1);
 
 /// CSR of the sorted, distinct parts of the elements around each node

@@ -5,12 +5,15 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/hdf5_failure.hpp"
+#include "runtime/scene_keys.hpp"
 
 namespace shatter {
 namespace {
@@ -18,7 +21,8 @@ namespace {
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
 
 constexpr const char* kFormat = "shatter-checkpoint";
-constexpr long kVersion = 2;  // 2: the step controller's state
+constexpr long kVersion = 3;  // 2: the step controller's state; 3: the scene's physics keys
+constexpr long kOldestVersion = 2;  // read without the physics check
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -28,6 +32,18 @@ std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 14695
   }
   return h;
 }
+
+/// A hash of every attribute of a checkpoint (names and values; a dataset's
+/// own hash of its bytes is one of them), summed so that the order of
+/// writing and reading does not matter. Stored as the root attribute
+/// state_fnv1a64: a file spliced from two checkpoints, each part intact in
+/// itself (datasets pass their own hashes), fails it.
+struct StateDigest {
+  std::uint64_t sum = 0;
+  void add(const char* name, const void* value, std::size_t bytes) {
+    sum += fnv1a(value, bytes, fnv1a(name, std::strlen(name)));
+  }
+};
 
 /// Owns one HDF5 identifier and closes it with the matching H5?close.
 class H5Handle {
@@ -44,21 +60,6 @@ class H5Handle {
  private:
   hid_t id_;
   herr_t (*close_)(hid_t);
-};
-
-/// Silences HDF5's error stack printing while alive: failures are reported
-/// by our own messages.
-class QuietHdf5 {
- public:
-  QuietHdf5() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
 };
 
 /// HDF5 types of the arrays a checkpoint holds: file() as stored
@@ -107,14 +108,17 @@ static_assert(sizeof(FacetState) == 1);
 
 struct Writer {
   std::string path;
+  mutable StateDigest digest;
   void check(bool ok, const std::string& what) const {
-    SHATTER_REQUIRE(ok, "checkpoint " << path << ": HDF5 failed to " << what);
+    SHATTER_REQUIRE(ok, "checkpoint " << path << ": " << hdf5_write_failure(what));
   }
   void attribute(hid_t object, const char* name, hid_t type, const void* value) const {
+    errno = 0;  // hdf5_write_failure reports the OS's reason of a failure in here
     H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
     H5Handle attr(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     check(space.valid() && attr.valid() && H5Awrite(attr.get(), type, value) >= 0,
           std::string("write attribute ") + name);
+    digest.add(name, value, H5Tget_size(type));
   }
   void number(hid_t object, const char* name, double v) const {
     attribute(object, name, H5T_NATIVE_DOUBLE, &v);
@@ -135,6 +139,7 @@ struct Writer {
     const hsize_t numbers = a.size() * FileType<T>::numbers;
     SHATTER_REQUIRE(numbers % cols == 0, "checkpoint: dataset " << name << " is not a whole number of rows");
     const std::array<hsize_t, 2> dims{numbers / cols, cols};
+    errno = 0;
     H5Handle space(H5Screate_simple(2, dims.data(), nullptr), H5Sclose);
     H5Handle dset(
         H5Dcreate2(group, name, FileType<T>::file(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
@@ -164,6 +169,7 @@ void sync_path(const std::filesystem::path& p, int flags) {
 
 struct Reader {
   std::string path;
+  mutable StateDigest digest;
   [[noreturn]] void fail(const std::string& why) const {
     throw InputError("--restart " + path + ": " + why);
   }
@@ -175,6 +181,7 @@ struct Reader {
     require(attr.valid() && H5Aread(attr.get(), type, value) >= 0,
             std::string("attribute ") + name +
                 " is missing or unreadable (truncated or corrupted checkpoint?)");
+    digest.add(name, value, H5Tget_size(type));
   }
   double number(hid_t object, const char* name) const {
     double v = 0;
@@ -197,6 +204,7 @@ struct Reader {
     std::string s(H5Tget_size(type.get()), '\0');
     require(H5Aread(attr.get(), type.get(), s.data()) >= 0,
             std::string("cannot read attribute ") + name);
+    digest.add(name, s.data(), s.size());
     return s.c_str();
   }
   /// Reads a dataset written by Writer::array: `expected` rows of `cols`
@@ -228,6 +236,24 @@ struct Reader {
   }
 };
 
+template <class... Arrays>
+std::uintmax_t bytes_of(const Arrays&... a) {
+  return ((a.size() * sizeof(typename Arrays::value_type)) + ...);
+}
+
+/// The bytes of the arrays a checkpoint of `s` holds (its metadata aside).
+std::uintmax_t checkpoint_bytes(const SimulationState& s) {
+  std::uintmax_t bytes = bytes_of(s.x, s.v, s.a, s.f_int, s.f_ext, s.reaction);
+  if (s.fracture) {
+    const FractureState& f = *s.fracture;
+    const CohesiveElements& c = f.cohesive;
+    bytes += bytes_of(f.reference, f.node_gid, f.node_body, f.conn, f.mass, f.bc_mask, f.bc_velocity,
+                      f.initial_velocity, f.facet_state, c.facet, c.side_local, c.side_nodes, c.area, c.normal,
+                      c.delta_max);
+  }
+  return bytes;
+}
+
 volatile std::sig_atomic_t g_stop_signal = 0;
 
 void record_stop_signal(int sig) {
@@ -249,14 +275,17 @@ std::uint64_t model_fingerprint(const Model& model) {
 void write_checkpoint(const std::filesystem::path& path, const Model& model,
                       const SimulationState& s, const std::string& failure) {
   const std::filesystem::path tmp = path.string() + ".tmp";
-  const Writer w{tmp.string()};
+  const Writer w{tmp.string(), {}};
   const QuietHdf5 quiet;
-  {
+  const std::string lacking = lacking_space(tmp.parent_path(), checkpoint_bytes(s));
+  SHATTER_REQUIRE(lacking.empty(), "checkpoint " << tmp.string() << ": not written: " << lacking);
+  try {
     H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
     // Version 2 object headers and superblock: HDF5 checksums all metadata.
     w.check(
         fapl.valid() && H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST) >= 0,
         "select the latest file format");
+    errno = 0;
     H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
     w.check(file.valid(), "create the file");
     H5Handle root_group(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose);
@@ -279,6 +308,11 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.number(root, "total0", s.total0);
     w.number(root, "energy_scale", s.energy_scale);
     w.text(root, "failure", failure);
+    const std::string physics = physics_keys(model.scene);
+    const std::uint64_t scene_fp = fnv1a(physics.data(), physics.size());
+    w.text(root, "physics", physics);
+    w.attribute(root, "scene_fingerprint", H5T_NATIVE_UINT64, &scene_fp);
+    w.integer(root, "history_every", model.scene.history_every);
 
     H5Handle state(H5Gcreate2(root, "state", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     w.check(state.valid(), "create group /state");
@@ -336,8 +370,19 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       w.rows(fr, "cohesive_normal", c.normal);
       w.array(fr, "cohesive_delta_max", c.delta_max, kCohesivePoints);
     }
+    // Last: the sum of everything written above (not itself part of it).
+    const std::uint64_t whole = w.digest.sum;
+    w.attribute(root, "state_fnv1a64", H5T_NATIVE_UINT64, &whole);
+    errno = 0;
     w.check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL) >= 0, "flush the file");
-  }  // closed here: everything is in the OS's hands
+    // Closed here (the handles above): everything is in the OS's hands.
+  } catch (const Error&) {
+    // The half-written file is of no use, and its space lets the other
+    // files close on a full disk (disk_reserve.hpp).
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
   sync_path(tmp, O_RDONLY);
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
@@ -348,8 +393,8 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
   sync_path(dir, O_RDONLY | O_DIRECTORY);
 }
 
-SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model) {
-  const Reader r{path.string()};
+SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model, CheckpointRun* run) {
+  const Reader r{path.string(), {}};
   r.require(std::filesystem::is_regular_file(path), "no such file");
   const QuietHdf5 quiet;
   r.require(H5Fis_hdf5(path.c_str()) > 0,
@@ -364,12 +409,28 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   r.require(root_group.valid(), "cannot open the root group (truncated or corrupted checkpoint?)");
   const hid_t root = root_group.get();
   r.require(r.text(root, "format") == kFormat, "not a shatter checkpoint");
-  r.require(r.integer(root, "version") == kVersion,
-            "checkpoint format version " + std::to_string(r.integer(root, "version")) +
-                ", this shatter reads " + std::to_string(kVersion));
+  const long version = r.integer(root, "version");
+  r.require(version >= kOldestVersion && version <= kVersion,
+            "checkpoint format version " + std::to_string(version) + ", this shatter reads " +
+                std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
   const std::string scene = r.text(root, "scene");
   r.require(scene == model.scene.name, "the checkpoint is of scene '" + scene + "', not of '" +
                                            model.scene.name + "' (" + model.scene.file + ")");
+  if (run) run->history_every = 0;  // version 2: not recorded
+  if (version >= 3) {
+    const std::string physics = r.text(root, "physics");
+    std::uint64_t scene_fp = 0;
+    r.attribute(root, "scene_fingerprint", H5T_NATIVE_UINT64, &scene_fp);
+    r.require(scene_fp == fnv1a(physics.data(), physics.size()),
+              "attribute physics fails its hash check (corrupted checkpoint)");
+    const KeyDifference d = first_difference(physics, physics_keys(model.scene));
+    r.require(d.key.empty(), d.key + " is " + d.a + " in the checkpoint's scene and " + d.b + " in " +
+                                 model.scene.file +
+                                 "; expected the physics of the checkpoint's run (a restart may "
+                                 "change only time.end, time.safety, time.dt, output and checkpoint)");
+    const long history_every = r.integer(root, "history_every");
+    if (run) run->history_every = history_every;
+  }
   const long nodes = r.integer(root, "nodes"), elements = r.integer(root, "elements"),
              order = r.integer(root, "order");
   if (nodes != model.mesh.num_nodes() || elements != model.mesh.num_elements() ||
@@ -466,6 +527,15 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   l.cohesive_elements = r.integer(g, "cohesive_elements");
   l.fragments = r.integer(g, "fragments");
   l.contact_capped_steps = r.integer(g, "contact_capped_steps");
+  if (version >= 3) {
+    r.text(root, "failure");  // read for the digest: every attribute written is read
+    const std::uint64_t sum = r.digest.sum;
+    std::uint64_t whole = 0;
+    r.attribute(root, "state_fnv1a64", H5T_NATIVE_UINT64, &whole);
+    r.require(whole == sum,
+              "the parts of the file do not belong together (spliced from different checkpoints, or "
+              "corrupted): the whole-file hash state_fnv1a64 fails");
+  }
   return s;
 }
 

@@ -10,7 +10,9 @@
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
-//       version       int64 2 (1: before the step controller; refused)
+//       version       int64 3 (2: without physics, scene_fingerprint and
+//                     history_every, read without the physics check; 1: before
+//                     the step controller, refused)
 //       scene         string, Scene::name
 //       nodes         int64, nodes of the model as built (before fracture)
 //       elements      int64
@@ -25,6 +27,17 @@
 //       total0, energy_scale   float64, J: Simulation::energy_error() reference
 //       failure       string: empty, or the error that stopped the run one
 //                     step after this (good) state
+//       physics       string: physics_keys() of the scene (scene_keys.hpp),
+//                     "key.path=value" lines; a restart names the first key
+//                     that differs
+//       scene_fingerprint  uint64: FNV-1a of the physics text
+//       history_every int64: output.history_every of the run, by which a
+//                     restart knows which rows history.csv must hold
+//       state_fnv1a64 uint64, written last: the sum over every other
+//                     attribute of the file (all groups, the datasets'
+//                     fnv1a64 included) of FNV-1a(name, value); a file spliced
+//                     from two checkpoints, each part passing its own hashes,
+//                     fails it
 //   /state/positions, velocities, accelerations, internal_forces,
 //          external_forces      n x 3 float64 (m, m/s, m/s^2, N, N)
 //   /state/reactions            b x 3 float64, N
@@ -75,7 +88,15 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 /// truncated or corrupted (HDF5 or hash check), of another scene or model
 /// (name, counts, fingerprint), or has a fracture state exactly when the
 /// scene has no fracture.
-SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model);
+/// Also refuses a scene whose physics (physics_keys(): materials, bodies,
+/// boundary conditions, contact, gravity, ...) differs from the checkpoint's,
+/// naming the first key that differs. `run`, when given, receives what the
+/// checkpoint says of the run that wrote it.
+struct CheckpointRun {
+  long history_every = 0;  ///< output.history_every of that run; 0: not recorded (version 2)
+};
+SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model,
+                                CheckpointRun* run = nullptr);
 
 /// Removes the rows of a CSV file whose first column (step) is above `step`,
 /// so that a restarted run appends its rows to it without duplicating any.

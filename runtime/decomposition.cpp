@@ -7,7 +7,7 @@
 
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
-#include "runtime/element_forces.hpp"
+#include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
 
 namespace shatter {
@@ -55,18 +55,14 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
                      "; it cannot be shared by " + std::to_string(size_) + " MPI ranks (use at most " +
                      std::to_string(ng) + ")");
   granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
-  std::vector<Index> per_rank(size_, 0);
   for (Index g = 0; g < ng; ++g) {
-    ++per_rank[granule_rank_[g]];
     if (granule_rank_[g] == rank_) {
       owned_granules_.push_back(g);
-      owned_elements_ += std::min(mesh.num_elements(), (g + 1) * ElementForces::kGranule) - g * ElementForces::kGranule;
+      for (Index e = g * ElementForces::kGranule; e < std::min(mesh.num_elements(), (g + 1) * ElementForces::kGranule); ++e)
+        owned_element_ids_.push_back(e);
     }
   }
-  for (int r = 0; r < size_; ++r)
-    if (per_rank[r] == 0)
-      throw InputError(model.scene.file + ": METIS left MPI rank " + std::to_string(r) + " of " +
-                       std::to_string(size_) + " without elements; use fewer ranks");
+  owned_elements_ = static_cast<Index>(owned_element_ids_.size());
   rebuild_nodes();
 }
 
@@ -76,18 +72,26 @@ void Decomposition::rebuild_nodes() {
   const Mesh& mesh = model_.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();
-  const Index ng = num_granules();
 
-  // Home granule of each node: the granule of the first element of its star.
+  // Home granule of each node: the granule of the first element of its star;
+  // the home nodes of each owned granule, ascending.
   home_granule_.resize(nn);
   for (Index n = 0; n < nn; ++n) home_granule_[n] = mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule;
-  home_offsets_.assign(ng + 1, 0);
-  for (Index n = 0; n < nn; ++n) ++home_offsets_[home_granule_[n] + 1];
-  for (Index g = 0; g < ng; ++g) home_offsets_[g + 1] += home_offsets_[g];
-  home_nodes_.resize(nn);
   {
+    std::vector<Index> slot(num_granules(), -1);
+    for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
+    home_offsets_.assign(owned_granules_.size() + 1, 0);
+    for (Index n = 0; n < nn; ++n)
+      if (slot[home_granule_[n]] >= 0) ++home_offsets_[slot[home_granule_[n]] + 1];
+    for (size_t k = 0; k < owned_granules_.size(); ++k) home_offsets_[k + 1] += home_offsets_[k];
+    home_nodes_.resize(home_offsets_.back());
+    owned_nodes_.clear();
     std::vector<Index> fill(home_offsets_.begin(), home_offsets_.end() - 1);
-    for (Index n = 0; n < nn; ++n) home_nodes_[fill[home_granule_[n]]++] = n;
+    for (Index n = 0; n < nn; ++n)
+      if (slot[home_granule_[n]] >= 0) {
+        home_nodes_[fill[slot[home_granule_[n]]]++] = n;
+        owned_nodes_.push_back(n);
+      }
   }
 
   if (size_ == 1) {
@@ -209,9 +213,12 @@ void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) cons
   if (rank_ == 0) unpack(all_nodes_, in, arrays);
 }
 
-void Decomposition::combine_granules(std::span<double> values) const {
-  if (size_ > 1)
-    MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
+void Decomposition::sum(std::span<ExactSum> values) const {
+  if (size_ > 1) allreduce(values, comm_);
+}
+
+void Decomposition::broadcast(std::span<double> values, int root) const {
+  if (size_ > 1) MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, root, comm_);
 }
 
 std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
@@ -234,6 +241,18 @@ double Decomposition::min(double value) const {
 int Decomposition::max(int value) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_INT, MPI_MAX, comm_);
   return value;
+}
+
+long Decomposition::max(long value) const {
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_LONG, MPI_MAX, comm_);
+  return value;
+}
+
+std::vector<long> Decomposition::gather(long value) const {
+  std::vector<long> all(rank_ == 0 ? size_ : 0);
+  if (size_ == 1) all[0] = value;
+  else MPI_Gather(&value, 1, MPI_LONG, all.data(), 1, MPI_LONG, 0, comm_);
+  return all;
 }
 
 }  // namespace shatter

@@ -18,11 +18,11 @@
 //     the ghost layer, not touched) from their owner, the smallest rank
 //     touching them (Halo, nonblocking).
 // Global sums (energies, momenta, work, body rows) are summed per granule by
-// the granule's owner - node sums over each node's HOME granule, the granule
-// of the first element of its star - exchanged by an exact MPI_Allreduce of
-// the per-granule array (each entry has one non-zero contribution, so the
-// reduction adds only zeros) and combined in granule order: every rank gets
-// the same bits as a serial run, for any decomposition.
+// the granule's owner, in a fixed order - a node counts in its HOME granule,
+// the granule of the first element of its star - and the granules' partial
+// sums are added exactly (ExactSum, kernels/exact_sum.hpp) and reduced over
+// the ranks by one reduction of constant size (sum()). The result is the
+// same double on every rank and for any decomposition and thread count.
 // With one rank (or MPI not initialised) nothing is communicated.
 #include <mpi.h>
 
@@ -30,7 +30,9 @@
 #include <span>
 #include <vector>
 
+#include "kernels/exact_sum.hpp"
 #include "kernels/types.hpp"
+#include "runtime/element_forces.hpp"
 #include "runtime/model.hpp"
 #include "runtime/parallel.hpp"
 
@@ -82,11 +84,21 @@ class Decomposition {
   std::span<const Index> held_nodes() const { return held_nodes_; }
   /// Nodes of owned elements (integrated here), ascending.
   std::span<const Index> touched_nodes() const { return touched_nodes_; }
-  /// Nodes whose home granule is g (the granule of their first element), ascending.
-  std::span<const Index> home_nodes(Index g) const {
-    return {home_nodes_.data() + home_offsets_[g], static_cast<size_t>(home_offsets_[g + 1] - home_offsets_[g])};
+  /// The home nodes of the k-th owned granule (owned_granules()[k]), ascending:
+  /// the nodes whose home granule (the granule of the first element of their
+  /// star) it is. A node's terms in global sums are added by its home
+  /// granule's owner, which touches it.
+  std::span<const Index> home_nodes(size_t k) const {
+    return {home_nodes_.data() + home_offsets_[k], static_cast<size_t>(home_offsets_[k + 1] - home_offsets_[k])};
   }
-  Index home_granule(Index node) const { return home_granule_[node]; }
+  /// The home nodes of all owned granules, ascending.
+  std::span<const Index> owned_nodes() const { return owned_nodes_; }
+  /// Whether this rank adds node n's terms to global sums (it owns n's home granule).
+  bool owns_node(Index n) const { return owns_granule(home_granule_[n]); }
+  /// Elements of the owned granules, ascending.
+  std::span<const Index> owned_element_ids() const { return owned_element_ids_; }
+  /// Whether element e is owned here.
+  bool owns_element(Index e) const { return owns_granule(e / ElementForces::kGranule); }
   /// The smallest rank touching the node.
   int node_owner(Index node) const { return size_ == 1 ? 0 : node_ranks_[node_rank_offsets_[node]]; }
   Index owned_elements() const { return owned_elements_; }
@@ -114,15 +126,23 @@ class Decomposition {
   /// Rank 0 receives the owners' values of every node (the others' arrays are unchanged).
   void gather_to_root(std::span<const std::span<Vec3>> arrays) const;
 
-  /// In place: per-granule partials [g * k + c], non-zero only on the
-  /// granule's owner, become the same complete array on every rank (exact).
-  void combine_granules(std::span<double> values) const;
+  /// In place: every rank's accumulators become their sum over the ranks
+  /// (exact; ~570 bytes per accumulator, whatever the model).
+  void sum(std::span<ExactSum> values) const;
+  /// Bytes one sum() of `count` accumulators sends per rank.
+  static std::size_t sum_bytes(std::size_t count) { return count * (sizeof(std::int64_t) * ExactSum::kDigits + 8); }
+  /// In place: `root`'s values on every rank.
+  void broadcast(std::span<double> values, int root) const;
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
   /// Global maximum of an int.
   int max(int value) const;
+  /// Global maximum of a long.
+  long max(long value) const;
+  /// Every rank's value in rank order, on rank 0 (empty elsewhere).
+  std::vector<long> gather(long value) const;
 
  private:
   const Model& model_;
@@ -134,7 +154,9 @@ class Decomposition {
   std::vector<Index> node_rank_offsets_;
   std::vector<int> node_ranks_;  ///< CSR: ranks touching each node, ascending (empty on one rank)
   std::vector<Index> local_elements_, held_nodes_, touched_nodes_, ghost_only_nodes_;
-  std::vector<Index> home_granule_, home_offsets_, home_nodes_;
+  std::vector<Index> owned_nodes_, owned_element_ids_;
+  std::vector<Index> home_granule_;               ///< per node
+  std::vector<Index> home_offsets_, home_nodes_;  ///< CSR over the owned granules' index k
   std::unique_ptr<Halo> halo_;
   SharedNodes all_nodes_;
 };

@@ -11,8 +11,8 @@
 // colors: a node whose whole element star is in the subset receives the same
 // contributions in the same order as in a serial run, i.e. the same bits. The
 // strain energy is summed per granule of kGranule consecutive elements, the
-// unit of ownership between ranks, so that sums over granules combined in
-// granule order do not depend on the decomposition.
+// unit of ownership between ranks, in element order; exact sums of the
+// granules' energies (ExactSum) then do not depend on the decomposition.
 #include <array>
 #include <functional>
 #include <span>
@@ -69,7 +69,7 @@ class ElementForces {
   std::span<const double> granule_energy() const { return granule_energy_; }
 
   /// f_int = dE/dx at positions x (overwrites f_int, size = nodes). The
-  /// result's strain_energy is the sum of granule_energy() in granule order,
+  /// result's strain_energy is the exact sum of granule_energy(),
   /// stable_dt and min_jacobian are over the computed elements. When
   /// stress6 is not empty, also writes each element's Cauchy stress there
   /// (6 per element, as element_cauchy_stress6) for the fracture check.
@@ -97,8 +97,5 @@ class ElementForces {
 /// Voigt components xx yy zz yz xz xy (Pa) written to out[0..5].
 void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e, double* out);
 
-/// element_cauchy_stress6 and the von Mises stress of every element.
-void element_stresses(const Model& model, std::span<const Vec3> x, std::vector<double>& stress6,
-                      std::vector<double>& von_mises_out);
 
 }  // namespace shatter

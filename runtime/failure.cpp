@@ -1,6 +1,7 @@
 #include "runtime/failure.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <thread>
 
 namespace shatter {
@@ -37,6 +38,24 @@ FailureAgreement FailureChannel::agree(int status, double patience) {
   }
   agreed_ = a;
   return a;
+}
+
+int report_failure(FailureChannel& failures, int status, const std::string& message) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const FailureAgreement a = failures.agree(status);
+  if (!a.all_ranks) {
+    std::fprintf(stderr,
+                 "error: %s\n(rank %d of %d failed alone while the others waited in a collective: "
+                 "every rank is ended with MPI_Abort; no checkpoint of this failure, an earlier "
+                 "one stays)\n",
+                 message.c_str(), rank, ranks);
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, status);
+  }
+  if (rank == 0) std::fprintf(stderr, "error: %s\n", message.c_str());
+  return a.status;
 }
 
 }  // namespace shatter

@@ -14,6 +14,7 @@
 #include <mpi.h>
 
 #include <optional>
+#include <string>
 
 namespace shatter {
 
@@ -47,5 +48,12 @@ class FailureChannel {
   int mine_ = 0, largest_ = 0;  ///< the reduction's buffers: they outlive a request left pending
   std::optional<FailureAgreement> agreed_;
 };
+
+/// The one message of a failure and the exit status `status` (1 or 2) of a
+/// run on the ranks of MPI_COMM_WORLD: when every rank failed, rank 0 prints
+/// "error: <message>" and the status is returned on every rank; a rank that
+/// failed alone prints its message with a note and ends every rank with
+/// MPI_Abort.
+int report_failure(FailureChannel& failures, int status, const std::string& message);
 
 }  // namespace shatter

@@ -3,6 +3,7 @@
 #include <hdf5.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "kernels/error.hpp"
+#include "runtime/hdf5_failure.hpp"
 
 namespace shatter {
 
@@ -47,12 +49,12 @@ class H5Id {
 
 /// Wraps a freshly created identifier; throws naming `what` when HDF5 failed.
 H5Id checked(hid_t id, herr_t (*close)(hid_t), const std::string& what) {
-  SHATTER_REQUIRE(id >= 0, "fields output: HDF5 failed to " << what);
+  SHATTER_REQUIRE(id >= 0, "fields output: " << hdf5_write_failure(what));
   return H5Id(id, close);
 }
 
 void check(herr_t status, const std::string& what) {
-  SHATTER_REQUIRE(status >= 0, "fields output: HDF5 failed to " << what);
+  SHATTER_REQUIRE(status >= 0, "fields output: " << hdf5_write_failure(what));
 }
 
 /// Row placement of one rank's part of a global array.
@@ -70,6 +72,7 @@ void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, 
   const std::array<hsize_t, 2> dims{rows.total, cols};
   const std::array<hsize_t, 2> local{rows.local, cols};
   const std::array<hsize_t, 2> start{rows.offset, 0};
+  errno = 0;  // hdf5_write_failure reports the OS's reason of a failure in here
   H5Id file_space = checked(H5Screate_simple(rank, dims.data(), nullptr), H5Sclose,
                             std::string("create the dataspace of ") + name);
   H5Id dset = checked(H5Dcreate2(group, name, file_type, file_space.get(), H5P_DEFAULT, H5P_DEFAULT,
@@ -96,6 +99,7 @@ void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, 
 
 /// Writes a scalar attribute (collective: every rank passes the same value).
 void write_attribute(hid_t object, const char* name, hid_t type, const void* value) {
+  errno = 0;
   H5Id space = checked(H5Screate(H5S_SCALAR), H5Sclose, "create a scalar space");
   H5Id attr = checked(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
                       H5Aclose, std::string("create attribute ") + name);
@@ -217,6 +221,16 @@ struct FieldWriter::State {
   long long mesh_nodes = -1, mesh_elements = -1;
   std::vector<FrameRecord> frames;
 
+  void write_frame(const Mesh& mesh, const FieldFrame& frame);
+
+  /// `e`'s message with the path of fields.h5 after "fields output".
+  Error naming_the_file(const Error& e) const {
+    std::string m = e.what();
+    const std::string prefix = "fields output: ";
+    if (m.rfind(prefix, 0) == 0) m = "fields output " + (xdmf_path.parent_path() / "fields.h5").string() + ": " + m.substr(prefix.size());
+    return Error(m);
+  }
+
   void write_xdmf() {
     std::string error;
     if (rank == 0 && !replace_file(xdmf_path, xdmf_text(frames)))
@@ -241,22 +255,41 @@ FieldWriter::FieldWriter(const std::filesystem::path& dir, MPI_Comm comm)
   }
   require_all(error, comm);
 
+  const QuietHdf5 quiet;
   H5Id fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create a file access list");
   check(H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL), "select the MPI-IO driver");
   check(H5Pset_coll_metadata_write(fapl.get(), true), "request collective metadata writes");
+  errno = 0;
   s.file = H5Id(H5Fcreate(h5_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
   if (!all_ok(s.file.valid(), comm))
-    throw Error("fields output: cannot create HDF5 file " + h5_path.string());
+    throw Error("fields output " + h5_path.string() + ": " + hdf5_write_failure("create the file"));
   checked(H5Gcreate2(s.file.get(), "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
           "create group /mesh");
   // An index without frames replaces any stale one from an earlier run.
   s.write_xdmf();
 }
 
-FieldWriter::~FieldWriter() = default;
+FieldWriter::~FieldWriter() {
+  if (!state_->file.valid()) return;
+  // A close whose metadata flush fails leaves HDF5 a freed file to close
+  // again at MPI_Finalize (hdf5_failure.hpp): flush first, and on failure
+  // give the disk reserve back so that the close finds room.
+  const QuietHdf5 quiet;
+  if (H5Fflush(state_->file.get(), H5F_SCOPE_GLOBAL) < 0) release_disk_space();
+  state_->file.reset();
+}
 
 void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
-  State& s = *state_;
+  const QuietHdf5 quiet;
+  try {
+    state_->write_frame(mesh, frame);
+  } catch (const Error& e) {
+    throw state_->naming_the_file(e);
+  }
+}
+
+void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) {
+  State& s = *this;
   const size_t n = static_cast<size_t>(mesh.num_nodes());
   const size_t e = static_cast<size_t>(mesh.num_elements());
 
@@ -306,6 +339,16 @@ void FieldWriter::write(const Mesh& mesh, const FieldFrame& frame) {
                             total[1] != s.mesh_elements;
   int changed = 0;
   MPI_Allreduce(&changed_local, &changed, 1, MPI_INT, MPI_MAX, s.comm);
+  // HDF5 1.10 cannot close a file whose flush failed (disk_reserve.hpp): a
+  // frame the disk has no room for is not begun.
+  if (s.rank == 0) {
+    const auto nodes = static_cast<std::uintmax_t>(total[0]), elements = static_cast<std::uintmax_t>(total[1]);
+    std::uintmax_t bytes = nodes * 6 * sizeof(double) + elements * (8 * sizeof(double) + 2 * sizeof(int));
+    if (changed) bytes += nodes * 3 * sizeof(double) + elements * k * sizeof(std::int64_t);
+    const std::string lacking = lacking_space(s.xdmf_path.parent_path(), bytes);
+    if (!lacking.empty()) error << "fields output: step " << frame.step << " not written: " << lacking;
+  }
+  require_all(error.str(), s.comm);
   if (changed) {
     const std::string name = "/mesh/" + std::to_string(s.mesh_count);
     H5Id group = checked(H5Gcreate2(s.file.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT,

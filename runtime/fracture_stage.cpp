@@ -34,9 +34,10 @@ CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3
   return cohesive_forces(model_.mesh, topology_, cohesive_, laws_, x, f_int);
 }
 
-std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6) {
+std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6,
+                                        std::span<const Index> local, std::span<const Index> owned) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_);
+  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_, local, owned);
   check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return critical;
 }

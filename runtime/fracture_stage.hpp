@@ -54,8 +54,11 @@ class FractureStage {
   CohesiveEnergy add_forces(std::span<const Vec3> x, std::span<Vec3> f_int);
 
   /// Facets whose traction (from the elements' Cauchy stresses, 6 Voigt
-  /// components per element) reaches the strength, sorted by facet gid.
-  std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6);
+  /// components per element) reaches the strength, sorted by facet gid; on
+  /// MPI ranks those whose smaller element is owned (critical_facets: `local`
+  /// and `owned` elements, empty on one rank).
+  std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6,
+                           std::span<const Index> local = {}, std::span<const Index> owned = {});
   /// The facets become cohesive elements (in canonical order, whatever the
   /// order given); nodes split. Returns what changed (new nodes to fill in by
   /// the caller).
@@ -79,6 +82,8 @@ class FractureStage {
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
+  /// The fragments' element ids and count (no statistics: no positions needed).
+  Fragments fragment_labels() const { return label_fragments(model_.mesh, topology_); }
   Index cohesive_count() const { return cohesive_.size(); }
   /// The crack surface (crack_area) with the fragments `frags` of the current state.
   CrackArea crack_area(const Fragments& frags) const {

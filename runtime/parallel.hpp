@@ -1,58 +1,34 @@
 #pragma once
-// Deterministic parallel reductions: the range is cut into fixed blocks that
-// do not depend on the thread count, partial results are computed in
-// parallel and combined serially in block order, so sums are bitwise equal
-// for any number of threads.
+// Parallel loops of the runtime: exact sums (bitwise equal for any number of
+// threads, since exact addition is associative) and plain loops.
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
-#include <vector>
+#include <array>
+#include <span>
 
+#include "kernels/exact_sum.hpp"
 #include "kernels/types.hpp"
 
 namespace shatter {
 
-inline constexpr Index kReduceBlock = 4096;
-
-/// sum over i in [0, n) of term(i), for term returning double, Vec3 or any
-/// type with operator+= and a zero given as `zero`.
-template <class T, class Term>
-T deterministic_sum(Index n, const T& zero, Term term) {
-  const Index blocks = (n + kReduceBlock - 1) / kReduceBlock;
-  std::vector<T> partial(blocks, zero);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, blocks), [&](const tbb::blocked_range<Index>& r) {
-    for (Index b = r.begin(); b < r.end(); ++b) {
-      T acc = zero;
-      const Index end = std::min(n, (b + 1) * kReduceBlock);
-      for (Index i = b * kReduceBlock; i < end; ++i) acc += term(i);
-      partial[b] = acc;
-    }
+/// K exact sums over the indices `items`: term(i, sums) adds index i's terms
+/// to sums[0..K) (ExactSum, kernels/exact_sum.hpp). The items are split over
+/// the threads in any way; the sums are exact, so the result does not depend
+/// on the split.
+template <int K, class Term>
+std::array<ExactSum, K> exact_sums(std::span<const Index> items, Term term) {
+  tbb::combinable<std::array<ExactSum, K>> partial;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    std::array<ExactSum, K>& sums = partial.local();
+    for (size_t k = r.begin(); k < r.end(); ++k) term(items[k], sums);
   });
-  T total = zero;
-  for (const T& p : partial) total += p;
+  std::array<ExactSum, K> total;
+  partial.combine_each([&](const std::array<ExactSum, K>& p) {
+    for (int c = 0; c < K; ++c) total[c] += p[c];
+  });
   return total;
-}
-
-/// The i in [0, n) with keep(i), ascending: blocks of kReduceBlock filtered
-/// in parallel and concatenated in block order (the same list for any thread count).
-template <class Keep>
-std::vector<Index> parallel_select(Index n, Keep keep) {
-  const Index blocks = (n + kReduceBlock - 1) / kReduceBlock;
-  std::vector<std::vector<Index>> partial(blocks);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, blocks), [&](const tbb::blocked_range<Index>& r) {
-    for (Index b = r.begin(); b < r.end(); ++b) {
-      const Index end = std::min(n, (b + 1) * kReduceBlock);
-      for (Index i = b * kReduceBlock; i < end; ++i)
-        if (keep(i)) partial[b].push_back(i);
-    }
-  });
-  std::vector<Index> out;
-  size_t total = 0;
-  for (const auto& p : partial) total += p.size();
-  out.reserve(total);
-  for (const auto& p : partial) out.insert(out.end(), p.begin(), p.end());
-  return out;
 }
 
 /// Apply body(i) for i in [0, n) in parallel (no reduction; any order).

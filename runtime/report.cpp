@@ -69,6 +69,11 @@ void JsonObject::add(const std::string& key, double value) {
   items_.emplace_back(key, os.str());
 }
 void JsonObject::add(const std::string& key, long value) { items_.emplace_back(key, std::to_string(value)); }
+void JsonObject::add(const std::string& key, const std::vector<long>& values) {
+  std::string list = "[";
+  for (size_t i = 0; i < values.size(); ++i) list += (i ? ", " : "") + std::to_string(values[i]);
+  items_.emplace_back(key, list + "]");
+}
 
 void JsonObject::write(const std::filesystem::path& path) const {
   const std::filesystem::path tmp = path.string() + ".tmp";

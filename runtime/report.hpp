@@ -32,13 +32,14 @@ class CsvWriter {
   bool first_ = true;
 };
 
-/// A flat JSON object writer for summary.json (string, number and integer values).
+/// A flat JSON object writer for summary.json (string, number and integer values, lists of integers).
 class JsonObject {
  public:
   void add(const std::string& key, const std::string& value);
   void add(const std::string& key, double value);
   void add(const std::string& key, long value);
   void add(const std::string& key, int value) { add(key, static_cast<long>(value)); }
+  void add(const std::string& key, const std::vector<long>& values);
   /// Write atomically (temporary file + rename).
   void write(const std::filesystem::path& path) const;
 

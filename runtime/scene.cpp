@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -124,12 +125,11 @@ YAML::Node walk(YAML::Node root, const std::string& path, const std::string& fil
     while (i < path.size() && path[i] == '[') {
       const std::size_t close = path.find(']', i);
       if (close == std::string::npos) bad("unclosed '['");
-      std::size_t idx = 0;
-      try {
-        idx = std::stoul(path.substr(i + 1, close - i - 1));
-      } catch (...) {
-        bad("expected an index inside [ ]");
-      }
+      const std::string digits = path.substr(i + 1, close - i - 1);
+      // stoul alone reads "0abc" and "0x1" as 0: only decimal digits are an index.
+      if (digits.empty() || digits.size() > 18 || digits.find_first_not_of("0123456789") != std::string::npos)
+        bad("expected a decimal index inside [ ], got '" + digits + "'");
+      const std::size_t idx = std::stoul(digits);
       if (!node.IsSequence() || idx >= node.size()) bad("index " + std::to_string(idx) + " is out of range");
       node.reset(node[idx]);
       i = close + 1;
@@ -137,6 +137,37 @@ YAML::Node walk(YAML::Node root, const std::string& path, const std::string& fil
     if (i < path.size() && path[i] == '.') ++i;
   }
   return node;
+}
+
+// yaml-cpp keeps every pair of a mapping with a repeated key, and a lookup
+// finds the first while a loop sees both: a repeated key is refused, with
+// both lines, wherever it is (`where` is the file, or the --set override).
+// Only scalar keys are compared (only_keys refuses the others); a tree deeper
+// than any scene (or an alias cycle, &a [*a]) is not descended further.
+void refuse_duplicate_keys(const YAML::Node& node, const std::string& key, const std::string& where,
+                           int depth = 0) {
+  if (depth > 32) return;
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i)
+      refuse_duplicate_keys(node[i], key + "[" + std::to_string(i) + "]", where, depth + 1);
+  } else if (node.IsMap()) {
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) continue;
+      const std::string k = kv.first.Scalar();
+      const std::string path = Reader::join(key, k);
+      const auto [first, fresh] = seen.emplace(k, kv.first.Mark());
+      if (!fresh) {
+        const YAML::Mark at = kv.first.Mark();
+        std::ostringstream os;
+        os << where << ":" << at.line + 1 << ":" << at.column + 1 << ": " << path
+           << ": duplicate key (first at line " << first->second.line + 1 << ":" << first->second.column + 1
+           << "); expected each key once in a mapping";
+        throw InputError(os.str());
+      }
+      refuse_duplicate_keys(kv.second, path, where, depth + 1);
+    }
+  }
 }
 
 ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& key) {
@@ -207,16 +238,20 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     os << path << ":" << e.mark.line + 1 << ":" << e.mark.column + 1 << ": not valid YAML: " << e.msg;
     throw InputError(os.str());
   }
+  refuse_duplicate_keys(root, "", path);
   for (const std::string& o : overrides) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
       throw InputError("--set " + o + ": expected key.path=value");
     YAML::Node target = walk(root, o.substr(0, eq), path);
+    YAML::Node value;
     try {
-      target = YAML::Load(o.substr(eq + 1));
+      value = YAML::Load(o.substr(eq + 1));
     } catch (const YAML::Exception& e) {
       throw InputError("--set " + o + ": the value is not valid YAML: " + e.msg);
     }
+    refuse_duplicate_keys(value, o.substr(0, eq), "--set " + o);
+    target = value;
   }
   r.only_keys(root, "", {"name", "time", "output", "materials", "bodies", "boundary_conditions", "contact",
                          "gravity", "checkpoint"});

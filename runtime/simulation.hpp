@@ -8,6 +8,12 @@
 //   4. a(n+1) = M^-1 (f_ext - f_int);  v(n+1) = v(n+1/2) + dt/2 a(n+1)
 //   5. fracture (when a material has a fracture block)
 //   6. ledger, output, progress
+// Simulation::step() is these stages in order (predict, resolve_contact,
+// compute_forces, correct, apply_fracture, update_ledger). Its members live
+// in one file per purpose: simulation.cpp (the step and its stages),
+// simulation_state.cpp (the state between steps, checkpoints),
+// simulation_output.cpp (history, bodies, fields, fragments, summary) and
+// simulation_run.cpp (run(): the loop, progress, checkpoints, failures).
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -19,8 +25,11 @@
 #include <vector>
 
 #include "runtime/element_forces.hpp"
+#include "kernels/exact_sum.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/ledger.hpp"
 #include "runtime/model.hpp"
+#include "runtime/step_control.hpp"
 
 namespace shatter {
 
@@ -43,59 +52,10 @@ struct RunOptions {
   /// alone (then it cannot be, runtime/failure.hpp). Null: every failure is
   /// taken as collective.
   FailureChannel* failures = nullptr;
-  /// A test of the failure path (SHATTER_TEST_FAIL=RANK:STEP in the CLI): step
-  /// `fail_step` throws Error on rank `fail_rank` only.
-  int fail_rank = -1;
-  long fail_step = 0;
-};
-
-/// The energy and momentum ledger of SCENE.md (history.csv columns), SI units.
-struct Ledger {
-  double kinetic = 0, strain = 0, cohesive_stored = 0, cohesive_dissipated = 0, contact_dissipated = 0,
-         external_work = 0;
-  Vec3 momentum = Vec3::Zero();          ///< kg m/s
-  Vec3 angular_momentum = Vec3::Zero();  ///< about the origin, kg m^2/s
-  long contacts = 0, cohesive_elements = 0, fragments = 0;
-  long contact_capped_steps = 0;  ///< steps whose DCR sweeps hit the cap (extra history column)
-  /// kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work
-  double total() const {
-    return kinetic + strain + cohesive_stored + cohesive_dissipated + contact_dissipated - external_work;
-  }
-};
-
-/// Control of the adaptive step (docs/physics.md "Step control"). Central
-/// difference is symplectic at a fixed step; a step re-evaluated from the
-/// state every step follows the vibration of the element that sets it, and
-/// the map is no longer symplectic: the energy drifts (Skeel, BIT 33 (1993)
-/// 172; Calvo & Sanz-Serna, SIAM J. Sci. Comput. 14 (1993) 936; Hairer,
-/// Lubich & Wanner, Geometric Numerical Integration, 2nd ed. 2006, sec. VIII.1).
-/// So the step is held constant and changes only
-///   - down, when the safe step (safety x stable step of the state at the
-///     start of a step) falls below it: to kHeadroom x the safe step, so a
-///     vibration of the safe step by less than the headroom does not move it
-///     again (the step is then the running minimum of the safe step, less the
-///     headroom: a monotone sequence);
-///   - up, at the end of a window of kWindow steps (counted from the last
-///     change or window) in which the safe step stayed above dt / kHeadroom:
-///     to min(kGrowth x dt, kHeadroom x the window's smallest safe step).
-/// The step taken is never above the safe step. Each change shifts the
-/// modified energy that a fixed step conserves by O(omega^2 |d(dt^2)|); a
-/// monotone sequence of drops shifts it by at most O(omega^2 dt0^2) in all and
-/// growth happens at most once per kWindow steps, so the energy error stays
-/// bounded instead of drifting. The state is deterministic (the safe step is
-/// a minimum over all ranks) and is part of a checkpoint.
-struct StepControl {
-  static constexpr double kHeadroom = 0.95;
-  static constexpr long kWindow = 1000;
-  static constexpr double kGrowth = 1.1;
-
-  double dt = 0;                 ///< s: the step held
-  double window_min = HUGE_VAL;  ///< s: smallest safe step in the current window
-  long window_steps = 0;         ///< steps in the current window
-
-  /// The step to take from a state whose safe step is `safe` (s); advances
-  /// the controller. The first call (dt = 0) takes the safe step.
-  double next(double safe);
+  /// Called on every rank before each step with the number of the step to
+  /// come (null: nothing); what it throws fails the step as the step would
+  /// (tests inject failures with it: tests/mpi/fail_alone.cpp).
+  std::function<void(long)> before_step;
 };
 
 /// The complete state of a run between two steps: what a checkpoint holds
@@ -154,15 +114,40 @@ class Simulation {
   void restore_state(const SimulationState& state);
 
  private:
+  // The stages of step(), in order.
+  /// v(n+1/2) = v(n) + dt/2 a(n) on the touched nodes (prescribed components set).
+  void half_kick();
+  /// half_kick, then x(n+1) = x(n) + dt v(n+1/2); keeps x(n) for contact and
+  /// the prescribed nodes' displacements for the reactions' work.
+  void predict();
+  /// DCR on x(n) -> x(n+1) (contact scenes).
+  void resolve_contact();
+  /// Gravity's work over the step, on the owned nodes.
+  void book_gravity_work();
+  /// The contact's first-order work, on the owned contact vertices (book_contact_work_).
+  void book_contact_work();
+  /// v(n+1) = v(n+1/2) + dt/2 a(n+1); the reactions' work over the step.
+  void correct(const std::vector<Vec3>& reaction_old);
   /// Forces and accelerations at x_; `step` and `time` (of the configuration
   /// x_) name it when an element is inverted. `between` goes to
   /// ElementForces::compute: it completes the ghost-only positions.
   void compute_forces(long step, double time, const std::function<void()>& between = {});
   void update_ledger();
+  /// K sums over this rank's owned nodes of term(node, partial), each owned
+  /// granule's home nodes added in plain double in node order, the granules'
+  /// partial sums exactly (any thread split gives the same bits; a node costs
+  /// K double additions, the exact ones are per granule).
+  template <int K, class Term>
+  std::array<ExactSum, K> granule_sums(Term term) const;
   void write_outputs(bool fields);
   /// `crack`: the crack surface at the end (fracture only; write_fragments).
+  /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
   void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range,
-                     const CrackArea& crack);
+                     const CrackArea& crack, const std::pair<std::vector<long>, long>& memory);
+  /// Bytes of the arrays this rank holds in the loop: the model's and the
+  /// time loop's own (nodal state, stresses); the contact and fracture
+  /// stages' are not counted.
+  long loop_bytes() const;
   /// Writes `s` (this rank's copy of the state, completed from the owners on
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
@@ -170,16 +155,16 @@ class Simulation {
   /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.
   double next_dt();
 
-  /// Ledger fields summed per granule (Decomposition): kinetic, p (3), L (3),
-  /// strain, the step's gravity work, the step's reaction work, the step's contact work
-  /// f(n+1) . (dx - dt/2 dv) (book_contact_work_).
-  static constexpr int kGranuleSums = 11;
+  /// The step's work terms, exact sums over this rank's owned nodes, summed
+  /// over the ranks by update_ledger: gravity's work, the reactions' work and,
+  /// with book_contact_work_, the contact's f(n+1) . (dx - dt/2 dv).
+  enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
 
   Model& model_;
   RunOptions opt_;
   std::unique_ptr<Decomposition> dec_;
   ElementForces elements_;
-  std::vector<double> granule_sums_;  ///< [g * kGranuleSums + field], this rank's granules only
+  std::array<ExactSum, kStepWorks> step_work_;  ///< since the last update_ledger(), this rank's part
   std::unique_ptr<SharedNodes> surface_nodes_;   ///< contact surface vertices shared by all ranks
   std::unique_ptr<SharedNodes> cohesive_nodes_;  ///< cohesive element nodes shared by all ranks
   /// After a topology change on several ranks: restrict the element loop to
@@ -189,6 +174,7 @@ class Simulation {
   std::vector<double> inv_mass_;
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
   std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
+  std::vector<Vec3> bc_dx_;            ///< per bc node: its displacement over the step under way, m
   double time_ = 0, dt_ = 0, stable_dt_ = 0;
   StepControl step_control_;
   long step_ = 0;
@@ -220,9 +206,10 @@ class Simulation {
   /// Writes fragments.csv from rank 0 (collective); returns the crack surface
   /// between those fragments on rank 0, zeros elsewhere.
   CrackArea write_fragments();
-  /// x and v of every node on rank 0: the own arrays on one rank, else
-  /// gathered from the owners into `x` and `v` (collective).
-  std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);
+  /// A field frame, written collectively: each rank sends its owned nodes' and
+  /// elements' rows to its block of the global order (row_blocks.hpp).
+  /// `elem_fragment`: fragment ids per element (fracture; empty otherwise).
+  void write_fields(std::span<const Index> elem_fragment);
 };
 
 }  // namespace shatter

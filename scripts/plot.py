@@ -32,21 +32,44 @@ def fail(message):
     sys.exit(2)
 
 
-def read_columns(path):
+def read_columns(path, text_columns=()):
     """Return {column name: list of floats} of a CSV file with a header row;
-    non-numeric columns (body names) are kept as strings."""
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        if not reader.fieldnames:
+    the columns named in `text_columns` (body names) are kept as strings.
+    A row that is not a row of numbers (corrupt, cut short, not text) ends
+    the script through fail() naming the file and the line."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        fail(f"{path}: cannot be read: {e.strerror}")
+    lines = []
+    for number, line in enumerate(raw.split(b"\n"), 1):
+        try:
+            lines.append(line.decode("utf-8").rstrip("\r"))
+        except UnicodeDecodeError:
+            fail(f"{path}:{number}: not text (not UTF-8); expected a CSV row of numbers")
+    if lines and lines[-1] == "":
+        lines.pop()
+    try:
+        reader = csv.reader(lines)
+        header = next(reader, None)
+        if not header:
             fail(f"{path}: no header row")
-        columns = {name: [] for name in reader.fieldnames}
+        columns = {name: [] for name in header}
         for row in reader:
-            for name in reader.fieldnames:
-                value = row[name]
+            where = f"{path}:{reader.line_num}"
+            if len(row) != len(header):
+                fail(f"{where}: expected {len(header)} comma-separated values, got {len(row)}")
+            for name, value in zip(header, row):
+                if name in text_columns:
+                    columns[name].append(value)
+                    continue
                 try:
                     columns[name].append(float(value))
-                except (TypeError, ValueError):
-                    columns[name].append(value)
+                except ValueError:
+                    fail(f"{where}: column {name}: expected a number, got {value[:40]!r}")
+    except csv.Error as e:
+        fail(f"{path}:{reader.line_num + 1}: not a CSV row ({e})")
     return columns
 
 
@@ -113,7 +136,7 @@ def plot_count(plt, h, run, plots_dir, column, label, name):
 
 
 def plot_bodies(plt, path, run, plots_dir):
-    b = read_columns(path)
+    b = read_columns(path, text_columns=("body",))
     require(b, ["time", "body", "vx", "vy", "vz"], path)
     names = list(dict.fromkeys(b["body"]))
     if len(names) > 12:

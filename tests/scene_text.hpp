@@ -17,6 +17,22 @@ inline std::string write_scene(const std::string& name, const std::string& yaml)
   return path.string();
 }
 
+/// The scene the command-line tests share: one steel box of 1 cm named b,
+/// meshed at `element_size`; `body` lines (indented by four spaces) are
+/// added to the body, `extra` lines at the top level.
+inline std::string steel_box_scene(const std::string& name, const std::string& element_size = "0.005",
+                                   const std::string& body = "", const std::string& extra = "") {
+  return "name: " + name +
+         "\ntime: {end: 1.0e-6}\n"
+         "materials:\n"
+         "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+         "bodies:\n"
+         "  - name: b\n"
+         "    material: steel\n"
+         "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: " +
+         element_size + "}\n" + body + extra;
+}
+
 inline Scene scene_from_text(const std::string& name, const std::string& yaml) {
   return load_scene(write_scene(name, yaml));
 }

@@ -1,5 +1,6 @@
 // Determinism: the facet check and the cohesive forces give identical results
-// for 1, 2 and 4 threads.
+// for 1, 2 and 4 threads, and the facet check split among owners of the
+// elements finds the same facets.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
@@ -58,6 +59,33 @@ TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
       for (const Index f : facets) found.push_back(t.facet_gid[f]);
       std::sort(direct.begin(), direct.end());
       EXPECT_EQ(found, direct);
+      // Split among 3 owners as ranks split the elements (interleaved runs
+      // of 37): each facet is found by the owner of its smaller element, and
+      // the owners' lists together are the whole list.
+      std::vector<Index> joined;
+      for (int part = 0; part < 3; ++part) {
+        std::vector<Index> owned, local;
+        for (Index e = 0; e < m.num_elements(); ++e)
+          if ((e / 37) % 3 == part) owned.push_back(e);
+        // The owned elements and their facet neighbours; the others' stresses spoiled.
+        std::vector<char> near(m.num_elements(), 0);
+        for (Index e : owned)
+          for (int i = 0; i < 4; ++i) {
+            const auto fe = t.facet_elem[t.elem_facet[4 * e + i]];
+            near[fe[0]] = 1;
+            if (fe[1] >= 0) near[fe[1]] = 1;
+          }
+        std::vector<double> spoiled = stress;
+        for (Index e = 0; e < m.num_elements(); ++e)
+          if (near[e]) local.push_back(e);
+          else for (int c = 0; c < 6; ++c) spoiled[6 * e + c] = 1e30;
+        const std::vector<Index> mine = critical_facets(m, t, m.reference, spoiled, 6, laws, local, owned);
+        for (const Index f : mine)
+          EXPECT_TRUE(std::binary_search(owned.begin(), owned.end(), std::min(t.facet_elem[f][0], t.facet_elem[f][1])));
+        joined.insert(joined.end(), mine.begin(), mine.end());
+      }
+      std::sort(joined.begin(), joined.end(), [&](Index a, Index b) { return t.facet_gid[a] < t.facet_gid[b]; });
+      EXPECT_EQ(joined, facets);
     } else {
       EXPECT_EQ(facets, reference_facets) << threads << " threads";
     }

@@ -100,6 +100,22 @@ TEST(Partition, Tet10GivesTheTet4DualGraphPartition) {
   EXPECT_EQ(partition_elements(m1, 3), partition_elements(m2, 3));
 }
 
+TEST(Partition, GranulesLeaveNoPartEmpty) {
+  // Up to one granule per part, where METIS alone leaves parts empty.
+  const Mesh mesh = box_mesh(1, 0.25);
+  const Index granule = 64, ng = (mesh.num_elements() + granule - 1) / granule;
+  ASSERT_GE(ng, 4);
+  for (int parts = 2; parts <= ng; ++parts) {
+    const std::vector<int> part = partition_granules(mesh, granule, parts);
+    ASSERT_EQ(static_cast<Index>(part.size()), ng);
+    std::vector<Index> count(parts, 0);
+    for (int p : part) ++count[p];
+    for (int p = 0; p < parts; ++p) EXPECT_GT(count[p], 0) << parts << " parts, part " << p;
+    EXPECT_EQ(partition_granules(mesh, granule, parts), part) << "repeat";
+  }
+  EXPECT_THROW(partition_granules(mesh, granule, static_cast<int>(ng) + 1), Error);
+}
+
 TEST(Partition, RejectsMorePartsThanElements) {
   const Mesh mesh = box_mesh(1, 0.5);
   EXPECT_THROW(partition_elements(mesh, mesh.num_elements() + 1), Error);

@@ -1,17 +1,18 @@
 #!/bin/bash
 # A failure on any rank ends the run on every rank with one message (issue 6,
 # docs/errors.md "On several ranks"), on 2 ranks:
-#   - rank 1 alone fails inside the time loop (SHATTER_TEST_FAIL=1:5) while
-#     rank 0 goes on into the step's collectives: exit 1, one error line;
+#   - rank 1 alone fails inside the time loop (fail_alone: it throws before
+#     step 5) while rank 0 goes on into the step's collectives: exit 1, one
+#     error line;
 #   - rank 0 alone fails (history.csv on a full disk: /dev/full) while rank 1
 #     waits in the first ledger reduction: exit 1, one error line;
 #   - every rank fails together (elements inverted by a step far above the
 #     stable one): exit 1, one error line, the last good state checkpointed;
 #   - bad input on every rank: exit 2, one error line.
 # A hang is caught by `timeout` (and ctest's TIMEOUT).
-# usage: failures.sh SHATTER MPIEXEC WORKDIR
+# usage: failures.sh SHATTER FAIL_ALONE MPIEXEC WORKDIR
 set -uo pipefail
-shatter=$1 mpiexec=$2 work=$3
+shatter=$1 fail_alone=$2 mpiexec=$3 work=$4
 rm -rf "$work"
 mkdir -p "$work"
 cat > "$work/box.yaml" <<'YAML'
@@ -48,8 +49,8 @@ run() {
 }
 mpi=("$mpiexec" --allow-run-as-root --oversubscribe -n 2 "$shatter" run "$work/box.yaml" --threads 1 --quiet)
 
-run lone_rank1 1 "error: step 5: failure injected on rank 1 by SHATTER_TEST_FAIL" \
-  SHATTER_TEST_FAIL=1:5 "${mpi[@]}" --out "$work/lone_rank1"
+run lone_rank1 1 "error: step 5: failure injected on rank 1 by the test" \
+  "$mpiexec" --allow-run-as-root --oversubscribe -n 2 "$fail_alone" "$work/box.yaml" "$work/lone_rank1" 1 5
 grep -q "rank 1 of 2 failed alone" "$work/lone_rank1.log" || { echo "FAIL lone_rank1: no note of the lone failure"; fail=1; }
 
 mkdir -p "$work/full"

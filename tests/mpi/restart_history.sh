@@ -1,5 +1,5 @@
 #!/bin/bash
-# Kill and restart across rank counts (issue 8 with issue 6): a run on 2 ranks
+# Kill and restart across rank counts (issues 6, 8 and 15): a run on 4 ranks
 # stopped by SIGTERM part way writes a checkpoint and exits non-zero; the
 # restart on 3 ranks must finish with history.csv and bodies.csv byte-equal to
 # an uninterrupted run on 1 rank.
@@ -11,7 +11,7 @@ rm -rf "$work"
 mkdir -p "$work"
 "$shatter" run "$scene" --out "$work/whole" --threads 1 --quiet || { echo "FAIL: the uninterrupted run"; exit 1; }
 rows=$(wc -l < "$work/whole/history.csv")
-"${mpi[@]}" -n 2 "$shatter" run "$scene" --out "$work/cut" --threads 1 --quiet 2> "$work/cut.log" &
+"${mpi[@]}" -n 4 "$shatter" run "$scene" --out "$work/cut" --threads 1 --quiet 2> "$work/cut.log" &
 job=$!
 # Stop it after about a third of the rows.
 for _ in $(seq 1 600); do
@@ -31,4 +31,4 @@ cut_rows=$(wc -l < "$work/cut/history.csv")
 for f in history.csv bodies.csv; do
   cmp "$work/whole/$f" "$work/cut/$f" || { echo "FAIL: $f differs"; diff "$work/whole/$f" "$work/cut/$f" | head -4; exit 1; }
 done
-echo "stopped after $cut_rows of $rows history rows on 2 ranks, restarted on 3: history and bodies byte-equal"
+echo "stopped after $cut_rows of $rows history rows on 4 ranks, restarted on 3: history and bodies byte-equal"

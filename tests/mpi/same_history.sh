@@ -1,6 +1,7 @@
 #!/bin/bash
-# The same scene on 1x1, 2x1, 1x2 and 3x1 ranks x threads must give the same
-# history.csv and bodies.csv (and fragments.csv), byte for byte (issue 6:
+# The same scene on 1x1, 2x1, 1x2, 3x1 and 4x1 ranks x threads must give the same
+# history.csv and bodies.csv (and fragments.csv, and fields.h5's datasets when
+# the scene writes frames), byte for byte (issue 6:
 # "bitwise with --deterministic"; the decomposed loop is bitwise for any
 # decomposition, so the flag changes nothing). Also checks that summary.json
 # names the ranks and that the comparison covers what the scene is for:
@@ -22,8 +23,9 @@ run 1 1
 run 2 1
 run 1 2
 run 3 1
+run 4 1
 status=0
-for d in r2t1 r1t2 r3t1; do
+for d in r2t1 r1t2 r3t1 r4t1; do
   for f in history.csv bodies.csv $([ "$kind" = fracture ] && echo fragments.csv); do
     if ! cmp -s "$work/r1t1/$f" "$work/$d/$f"; then
       echo "FAIL: $d/$f differs from r1t1/$f:"
@@ -31,6 +33,12 @@ for d in r2t1 r1t2 r3t1; do
       status=1
     fi
   done
+  # Field frames (when the scene writes them): every dataset the same bits.
+  if [ -f "$work/r1t1/fields.h5" ]; then
+    /usr/bin/python3 "$(dirname "$0")/same_fields.py" "$work/r1t1/fields.h5" "$work/$d/fields.h5" > /dev/null ||
+      { echo "FAIL: $d/fields.h5 differs from r1t1/fields.h5"; status=1; }
+    cmp -s "$work/r1t1/fields.xdmf" "$work/$d/fields.xdmf" || { echo "FAIL: $d/fields.xdmf differs"; status=1; }
+  fi
 done
 grep -q '"ranks": 3' "$work/r3t1/summary.json" || { echo "FAIL: r3t1/summary.json does not say 3 ranks"; status=1; }
 if [ "$kind" = contact ]; then
@@ -46,5 +54,5 @@ else
   what="$n cohesive elements across ranks at 3 ranks"
 fi
 [ "${n:-0}" -gt 0 ] || { echo "FAIL: $what: the comparison does not cover $kind"; status=1; }
-[ $status -eq 0 ] && echo "same outputs at 1x1, 2x1, 1x2, 3x1 ($what)"
+[ $status -eq 0 ] && echo "same outputs at 1x1, 2x1, 1x2, 3x1, 4x1 ($what)"
 exit $status

@@ -31,8 +31,12 @@
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
 #include "scene_text.hpp"
+#include "shatter_cli.hpp"
 
 using namespace shatter;
+using shatter::test::Child;
+using shatter::test::finish;
+using shatter::test::start_shatter;
 using shatter::test::scene_from_text;
 using shatter::test::write_scene;
 namespace fs = std::filesystem;
@@ -216,36 +220,6 @@ std::string slurp(const fs::path& p) {
   return os.str();
 }
 
-struct Child {
-  pid_t pid = -1;
-  fs::path log;
-};
-
-/// Starts the shatter binary with `args`, stdout and stderr to `log`.
-Child start_shatter(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv{std::string(SHATTER_BINARY_DIR) + "/apps/shatter"};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> cargv;
-  for (auto& a : argv) cargv.push_back(a.data());
-  cargv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  Child c;
-  c.log = log;
-  EXPECT_EQ(posix_spawn(&c.pid, cargv[0], &actions, nullptr, cargv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
-  return c;
-}
-
-/// Waits for the child; returns its exit status (-1 when killed by a signal).
-int finish(const Child& c) {
-  int st = 0;
-  EXPECT_EQ(waitpid(c.pid, &st, 0), c.pid);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 long count_lines(const fs::path& p) {
   std::ifstream in(p);
   long n = 0;
@@ -365,14 +339,33 @@ TEST(Checkpoint, CheckpointOfAnotherModelIsRefused) {
             std::string::npos)
       << refusal(file, renamed);
 
+  // A changed physics key is named, with both values (physics_keys, scene_keys.hpp).
   Model finer = build_model(scene_from_text("ckpt_other", free_scene("ckpt_other", "0.003")));
-  EXPECT_NE(refusal(file, finer).find("nodes and"), std::string::npos) << refusal(file, finer);
+  EXPECT_NE(refusal(file, finer).find("bodies[0].mesh.element_size is 0.004 in the checkpoint's scene and 0.003"),
+            std::string::npos)
+      << refusal(file, finer);
 
   std::string yaml = free_scene("ckpt_other");
   yaml.replace(yaml.find("density: 7850"), 13, "density: 7851");
   Model heavier = build_model(scene_from_text("ckpt_other", yaml));
-  EXPECT_NE(refusal(file, heavier).find("model differs"), std::string::npos)
+  EXPECT_NE(refusal(file, heavier).find("materials.steel.density is 7850 in the checkpoint's scene and 7851"),
+            std::string::npos)
       << refusal(file, heavier);
+
+  // Young's modulus and gravity change neither the mesh nor the masses (the
+  // model fingerprint): the physics keys find them.
+  yaml = free_scene("ckpt_other");
+  yaml.replace(yaml.find("youngs_modulus: 210.0e9"), 23, "youngs_modulus: 100.0e9");
+  Model softer = build_model(scene_from_text("ckpt_other", yaml));
+  EXPECT_NE(refusal(file, softer).find("materials.steel.youngs_modulus is 210000000000 in the checkpoint's scene "
+                                       "and 100000000000"),
+            std::string::npos)
+      << refusal(file, softer);
+  yaml = free_scene("ckpt_other");
+  yaml.replace(yaml.find("gravity: [0, 0, -9.81]"), 22, "gravity: [0, 0, -1.62]");
+  Model moon = build_model(scene_from_text("ckpt_other", yaml));
+  EXPECT_NE(refusal(file, moon).find("gravity[2] is -9.81 in the checkpoint's scene and -1.62"), std::string::npos)
+      << refusal(file, moon);
 
   // time.safety and time.end may change at a restart.
   yaml = free_scene("ckpt_other");
@@ -385,7 +378,8 @@ TEST(Checkpoint, CheckpointOfAnotherModelIsRefused) {
 }
 
 // A checkpoint without a fracture state does not restart a scene with
-// fracture (same mesh and masses: the fingerprint alone would accept it).
+// fracture (same mesh and masses: the model fingerprint alone would accept
+// it; the physics keys name the fracture block).
 TEST(Checkpoint, FractureStateMustMatchTheScene) {
   const fs::path file = test_dir("fracture") / "checkpoint.h5";
   checkpoint_after("ckpt_fracture", free_scene("ckpt_fracture"), 3, file);
@@ -394,12 +388,15 @@ TEST(Checkpoint, FractureStateMustMatchTheScene) {
                "poisson_ratio: 0.3, fracture: {strength: 1.0e9, energy: 1.0e4}}");
   Model model = build_model(scene_from_text("ckpt_fracture", yaml));
   const std::string why = refusal(file, model);
-  EXPECT_NE(why.find("the scene has fracture but the checkpoint has no fracture state"), std::string::npos)
+  EXPECT_NE(why.find("materials.steel.fracture.strength is (none) in the checkpoint's scene and 1000000000"),
+            std::string::npos)
       << why;
 
   checkpoint_after("ckpt_fracture", yaml, 3, file);
   Model plain = build_model(scene_from_text("ckpt_fracture", free_scene("ckpt_fracture")));
-  EXPECT_NE(refusal(file, plain).find("has a fracture state but the scene has no fracture"), std::string::npos)
+  EXPECT_NE(refusal(file, plain).find("materials.steel.fracture.strength is 1000000000 in the checkpoint's scene "
+                                      "and (none)"),
+            std::string::npos)
       << refusal(file, plain);
 }
 

@@ -1,7 +1,7 @@
 // The decomposition of the time loop (runtime/decomposition.hpp), run at 1, 2
 // and 3 ranks: ownership covers everything once, a touched node has its whole
-// star locally, ghost updates and shares deliver the owners' values, granule
-// sums are exact, and the restricted element loop gives touched nodes the
+// star locally, ghost updates and shares deliver the owners' values, exact
+// sums over the owned granules give the serial total, and the restricted element loop gives touched nodes the
 // serial forces bit for bit.
 #include <gtest/gtest.h>
 
@@ -54,22 +54,33 @@ TEST(Decomposition, OwnershipCoversEverythingOnce) {
   MPI_Allreduce(&owned, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(total, d.num_granules());
   for (Index g : d.owned_granules()) EXPECT_TRUE(d.owns_granule(g));
-  // Home granules split the nodes: each node once, in the granule of its first element.
+  // Home granules split the nodes: each node once, in the granule of its
+  // first element, on that granule's owner.
   std::vector<int> seen(mesh.num_nodes(), 0);
-  for (Index g = 0; g < d.num_granules(); ++g)
-    for (Index n : d.home_nodes(g)) {
-      ++seen[n];
-      EXPECT_EQ(mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule, g);
+  const auto granules = d.owned_granules();
+  size_t homed = 0;
+  for (size_t k = 0; k < granules.size(); ++k)
+    for (Index n : d.home_nodes(k)) {
+      EXPECT_EQ(mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule, granules[k]);
+      ++homed;
     }
-  for (Index n = 0; n < mesh.num_nodes(); ++n) EXPECT_EQ(seen[n], 1);
-  // A touched node's whole star is local; the home node of an owned granule is touched here.
+  EXPECT_EQ(homed, d.owned_nodes().size());
+  for (Index n : d.owned_nodes()) {
+    seen[n] = 1;
+    EXPECT_TRUE(d.owns_node(n));
+  }
+  MPI_Allreduce(MPI_IN_PLACE, seen.data(), static_cast<int>(seen.size()), MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  for (Index n = 0; n < mesh.num_nodes(); ++n) EXPECT_EQ(seen[n], 1) << "node " << n;
+  // Owned elements: those of the owned granules.
+  EXPECT_EQ(static_cast<Index>(d.owned_element_ids().size()), d.owned_elements());
+  for (Index e : d.owned_element_ids()) EXPECT_TRUE(d.owns_element(e));
+  // A touched node's whole star is local; an owned node is touched here.
   const auto local = d.local_elements();
   for (Index n : d.touched_nodes())
     for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
       EXPECT_TRUE(std::binary_search(local.begin(), local.end(), mesh.node_elem[p]));
   const auto touched = d.touched_nodes();
-  for (Index g : d.owned_granules())
-    for (Index n : d.home_nodes(g)) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), n));
+  for (Index n : d.owned_nodes()) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), n));
   if (d.size() > 1) {
     EXPECT_LT(static_cast<Index>(local.size()), mesh.num_elements());
   }
@@ -105,7 +116,7 @@ TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
   for (size_t i = 1; i < all.size(); ++i) EXPECT_LE(all[i - 1], all[i]);
 }
 
-TEST(Decomposition, GranuleSumsAreExactAndRestrictedForcesAreSerial) {
+TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
   const Model& m = box();
   const Decomposition d(m, MPI_COMM_WORLD);
   const Index nn = m.mesh.num_nodes();
@@ -130,17 +141,16 @@ TEST(Decomposition, GranuleSumsAreExactAndRestrictedForcesAreSerial) {
   EXPECT_TRUE(between_ran);
   for (Index n : d.touched_nodes()) EXPECT_TRUE(same_bits(f[n], f_serial[n])) << "node " << n;
 
-  // Owned granules' energies, combined, summed in granule order: the serial total.
-  std::vector<double> e(d.num_granules(), 0.0);
-  for (Index g : d.owned_granules()) e[g] = restricted.granule_energy()[g];
-  d.combine_granules(e);
-  double total = 0;
-  for (Index g = 0; g < d.num_granules(); ++g) {
-    EXPECT_EQ(e[g], serial.granule_energy()[g]) << "granule " << g;
-    total += e[g];
+  // Owned granules' energies are the serial ones; summed exactly over the
+  // ranks they give the serial total, bit for bit.
+  ExactSum total;
+  for (Index g : d.owned_granules()) {
+    EXPECT_EQ(restricted.granule_energy()[g], serial.granule_energy()[g]) << "granule " << g;
+    total += restricted.granule_energy()[g];
   }
-  EXPECT_EQ(total, whole.strain_energy);
-  EXPECT_GT(total, 0.0);
+  d.sum({&total, 1});
+  EXPECT_EQ(total.value(), whole.strain_energy);
+  EXPECT_GT(total.value(), 0.0);
 }
 
 }  // namespace

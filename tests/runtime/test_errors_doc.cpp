@@ -127,6 +127,24 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
   shatter::SimulationState state;
   sim.save_state(state);
   shatter::write_checkpoint(dir / "other.h5", model, state);
+  // A run of the base scene stopped after one step, its rows lost.
+  fs::create_directories(dir / "run");
+  shatter::Model good = shatter::build_model(shatter::load_scene((dir / "scene.yaml").string()));
+  shatter::Simulation run(good, {});
+  run.step();
+  run.save_state(state);
+  shatter::write_checkpoint(dir / "run" / "checkpoint.h5", good, state);
+  std::ofstream(dir / "run" / "history.csv") << "step,time,dt,kinetic\n";
+  std::ofstream(dir / "run" / "bodies.csv") << "step,time,body,mass\n";
+  std::ofstream(dir / "dup.yaml") << "name: x\ntime: {end: 1}\ntime: {end: 2}\n";
+  fs::create_directories(dir / "taken" / "fields.h5");
+  fs::create_directories(dir / "device");
+  fs::create_symlink("/dev/full", dir / "device" / "fields.h5");
+  fs::create_directories(dir / "corrupt_run");
+  std::ofstream(dir / "corrupt_run" / "history.csv")
+      << "step,time,dt,kinetic,strain,cohesive_stored,cohesive_dissipated,contact_dissipated,external_work,total,"
+         "px,py,pz,Lx,Ly,Lz,contacts,cohesive_elements,fragments,contact_capped_steps\n"
+         "0,0,1,1,0,0,0,0,0,1,0,0,0,0,0,0,0,0,1,0\n1,0.1,1,xx\n";
 }
 
 /// Exit status and first output line of `shatter args` (stdout and stderr).

@@ -1,0 +1,259 @@
+// Simulation: the run's outputs (SCENE.md "Outputs"): history.csv and
+// bodies.csv rows, field frames, fragments.csv and summary.json.
+#include <algorithm>
+#include <optional>
+
+#include "runtime/contact_stage.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/field_output.hpp"
+#include "runtime/fracture_stage.hpp"
+#include "runtime/global_sum.hpp"
+#include "runtime/parallel.hpp"
+#include "runtime/report.hpp"
+#include "runtime/row_blocks.hpp"
+#include "runtime/simulation.hpp"
+#include "runtime/timed.hpp"
+
+namespace shatter {
+namespace {
+
+struct BodyRow {
+  double mass = 0;
+  Vec3 mx = Vec3::Zero(), mv = Vec3::Zero();
+};
+
+}  // namespace
+
+void Simulation::write_outputs(bool fields) {
+  if (opt_.out_dir.empty()) return;
+  const bool root = dec_->rank() == 0;
+  // The fragments' element ids: topology, the same on every rank.
+  std::optional<Fragments> frags;
+  if (fracture_) {
+    frags = fracture_->fragment_labels();
+    ledger_.fragments = frags->count();
+  }
+  const Ledger& l = ledger_;
+  if (root) {
+    *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
+              << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
+              << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
+              << l.contacts << l.cohesive_elements << l.fragments << l.contact_capped_steps;
+    history_->end_row();
+  }
+
+  // Body rows: mass, m x, m v per body, exact sums over the owned nodes.
+  const Mesh& mesh = model_.mesh;
+  const int nb = static_cast<int>(model_.scene.bodies.size());
+  std::vector<ExactSum> sums(static_cast<size_t>(nb) * 7);
+  for (Index i : dec_->owned_nodes()) {
+    ExactSum* r = sums.data() + static_cast<size_t>(mesh.node_body[i]) * 7;
+    const double m = model_.mass[i];
+    r[0] += m;
+    for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
+  }
+  timed(comm_seconds_, [&] { dec_->sum(sums); });
+  std::vector<BodyRow> rows(nb);
+  for (int b = 0; b < nb; ++b) {
+    const ExactSum* r = sums.data() + static_cast<size_t>(b) * 7;
+    rows[b].mass = r[0].value();
+    rows[b].mx = Vec3(r[1].value(), r[2].value(), r[3].value());
+    rows[b].mv = Vec3(r[4].value(), r[5].value(), r[6].value());
+  }
+  for (int b = 0; b < nb && root; ++b) {
+    const Vec3 c = rows[b].mx / rows[b].mass, v = rows[b].mv / rows[b].mass;
+    *bodies_ << step_ << time_ << model_.scene.bodies[b].name << rows[b].mass << c.x() << c.y() << c.z() << v.x()
+             << v.y() << v.z();
+    bodies_->end_row();
+  }
+
+  if (fields && fields_) write_fields(frags ? frags->elem_fragment : std::span<const Index>{});
+}
+
+void Simulation::write_fields(std::span<const Index> elem_fragment) {
+  // Each rank packs its owned nodes and elements; the rows move to
+  // contiguous blocks in global order (row_blocks.hpp), which each rank
+  // writes collectively: the file is the same for any decomposition, and no
+  // rank gathers the model.
+  const Mesh& mesh = model_.mesh;
+  const int k = mesh.nodes_per_element();
+  const bool cracks = !elem_fragment.empty();
+  const std::span<const Index> nodes = dec_->owned_nodes(), elems = dec_->owned_element_ids();
+  constexpr int kNodeWidth = 9;  // X, u, v
+  std::vector<double> node_rows(nodes.size() * kNodeWidth);
+  parallel_for_each(static_cast<Index>(nodes.size()), [&](Index r) {
+    const Index i = nodes[r];
+    double* o = node_rows.data() + static_cast<size_t>(r) * kNodeWidth;
+    const Vec3 u = x_[i] - mesh.reference[i];
+    for (int c = 0; c < 3; ++c) o[c] = mesh.reference[i][c], o[3 + c] = u[c], o[6 + c] = v_[i][c];
+  });
+  // Per element: connectivity, stress (6), von Mises, body, and with fracture fragment and damage.
+  const int width = k + 9 + (cracks ? 2 : 0);
+  const std::vector<double> damage = cracks ? fracture_->damage() : std::vector<double>{};
+  std::vector<double> elem_rows(elems.size() * width);
+  parallel_for_each(static_cast<Index>(elems.size()), [&](Index r) {
+    const Index e = elems[r];
+    double* o = elem_rows.data() + static_cast<size_t>(r) * width;
+    for (int a = 0; a < k; ++a) o[a] = mesh.element(e)[a];
+    double* s6 = o + k;
+    element_cauchy_stress6(model_, x_, e, s6);
+    Mat3 sigma;
+    sigma << s6[0], s6[5], s6[4], s6[5], s6[1], s6[3], s6[4], s6[3], s6[2];
+    o[k + 6] = von_mises(sigma);
+    o[k + 7] = mesh.elem_body[e];
+    if (cracks) o[k + 8] = elem_fragment[e], o[k + 9] = damage[e];
+  });
+  const MPI_Comm comm = dec_->distributed() ? dec_->comm() : MPI_COMM_SELF;
+  const std::vector<double> nb = to_row_blocks(nodes, node_rows, kNodeWidth, mesh.num_nodes(), comm);
+  const std::vector<double> eb = to_row_blocks(elems, elem_rows, width, mesh.num_elements(), comm);
+
+  // This rank's block as a mesh (connectivity in global node rows) and frame.
+  const size_t bn = nb.size() / kNodeWidth, be = eb.size() / width;
+  Mesh block;
+  block.order = mesh.order;
+  block.revision = mesh.revision;
+  block.reference.resize(bn);
+  std::vector<Vec3> u(bn), v(bn);
+  for (size_t r = 0; r < bn; ++r) {
+    const double* o = nb.data() + r * kNodeWidth;
+    block.reference[r] = Vec3(o[0], o[1], o[2]);
+    u[r] = Vec3(o[3], o[4], o[5]);
+    v[r] = Vec3(o[6], o[7], o[8]);
+  }
+  block.conn.resize(be * k);
+  block.elem_gid.resize(be);
+  std::vector<double> stress(6 * be), vm(be), block_damage(cracks ? be : 0);
+  std::vector<int> body(be), fragment(cracks ? be : 0);
+  for (size_t r = 0; r < be; ++r) {
+    const double* o = eb.data() + r * width;
+    for (int a = 0; a < k; ++a) block.conn[r * k + a] = static_cast<Index>(o[a]);
+    std::copy_n(o + k, 6, stress.begin() + 6 * r);
+    vm[r] = o[k + 6];
+    body[r] = static_cast<int>(o[k + 7]);
+    if (cracks) fragment[r] = static_cast<int>(o[k + 8]), block_damage[r] = o[k + 9];
+  }
+  FieldFrame f;
+  f.step = static_cast<int>(step_);
+  f.time = time_;
+  f.displacement = u;
+  f.velocity = v;
+  f.stress = stress;
+  f.von_mises = vm;
+  f.body = body;
+  f.fragment = fragment;
+  f.damage = block_damage;
+  fields_->write(block, f);
+}
+
+CrackArea Simulation::write_fragments() {
+  // Each rank sums its owned nodes and elements, exactly; rank 0 adds the ranks' sums.
+  Fragments frags = fracture_->fragment_labels();
+  std::vector<ExactSum> sums = fragment_sums(model_.mesh, frags, dec_->owned_nodes(), dec_->owned_element_ids(), x_,
+                                             v_, model_.mass);
+  if (dec_->distributed()) reduce_to_root(sums, dec_->comm());
+  if (dec_->rank() != 0) return {};
+  set_fragment_stats(frags, sums);
+  CsvWriter out(opt_.out_dir / "fragments.csv",
+                {"id", "mass", "volume", "cx", "cy", "cz", "vx", "vy", "vz", "elements"});
+  for (Index k = 0; k < frags.count(); ++k) {
+    const FragmentStats& s = frags.stats[k];
+    out << static_cast<long>(k) << s.mass << s.volume << s.centre.x() << s.centre.y() << s.centre.z()
+        << s.velocity.x() << s.velocity.y() << s.velocity.z() << static_cast<long>(s.elements);
+    out.end_row();
+  }
+  return fracture_->crack_area(frags);
+}
+
+long Simulation::loop_bytes() const {
+  auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
+  return static_cast<long>(model_bytes(model_)) + b(x_) + b(v_) + b(a_) + b(f_int_) + b(f_ext_) + b(inv_mass_) +
+         b(bc_nodes_) + b(reaction_) + b(x_prev_) + b(contact_inv_mass_) + b(stress6_);
+}
+
+void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs,
+                               const CrackArea& crack, const std::pair<std::vector<long>, long>& memory) {
+  const Ledger& l = ledger_;
+  JsonObject j;
+  j.add("name", model_.scene.name);
+  j.add("scene", model_.scene.file);
+  j.add("ranks", dec_->size());
+  j.add("threads", opt_.threads);
+  j.add("deterministic", std::string(opt_.deterministic ? "true" : "false"));
+  j.add("steps", step_);
+  j.add("end_time", time_);
+  j.add("wall_time", wall);
+  j.add("time_per_step", step_ > 0 ? wall / step_ : 0.0);
+  j.add("element_loop_time", element_seconds_);
+  // element-steps per second per core spent in the element loop
+  j.add("element_updates_per_second",
+        element_seconds_ > 0 ? double(dec_->local_elements().size()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
+  j.add("peak_memory_bytes", peak_memory_bytes());
+  j.add("peak_memory_bytes_per_rank", memory.first);
+  j.add("model_bytes_per_rank_max", memory.second);
+  // Decomposition (docs/parallel.md): balance and bytes per step.
+  j.add("owned_elements_min", stats.owned_min);
+  j.add("owned_elements_max", stats.owned_max);
+  j.add("local_elements_max", stats.local_max);
+  j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
+  j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
+  j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
+  // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
+  j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(8 + kStepWorks) : 0));
+  // The contact stage's exchanges included (contact_exchange_time).
+  j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
+  j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
+  j.add("elements", static_cast<long>(model_.mesh.num_elements()));
+  j.add("element_order", model_.mesh.order);
+  j.add("bodies", static_cast<long>(model_.scene.bodies.size()));
+  j.add("kinetic", l.kinetic);
+  j.add("strain", l.strain);
+  j.add("cohesive_stored", l.cohesive_stored);
+  j.add("cohesive_dissipated", l.cohesive_dissipated);
+  j.add("contact_dissipated", l.contact_dissipated);
+  j.add("external_work", l.external_work);
+  j.add("total", l.total());
+  j.add("initial_total", total0_);
+  j.add("energy_error", energy_error());
+  j.add("contacts", l.contacts);
+  j.add("cohesive_elements", l.cohesive_elements);
+  j.add("fragments", l.fragments);
+  j.add("contact_capped_steps", l.contact_capped_steps);
+  if (fracture_) {
+    j.add("fracture_check_time", fracture_->check_seconds());
+    // Cohesive elements between elements of different ranks: cracks across subdomains.
+    long across = 0;
+    for (Index f : fracture_->cohesive_facets()) {
+      const auto& fe = fracture_->topology().facet_elem[f];
+      across += dec_->granule_rank(fe[0] / ElementForces::kGranule) != dec_->granule_rank(fe[1] / ElementForces::kGranule);
+    }
+    j.add("cohesive_elements_across_ranks", across);
+    j.add("crack_area_debonded", crack.debonded);
+    j.add("crack_area_between_fragments", crack.between_fragments);
+    j.add("cohesive_dissipated_debonded", crack.debonded_dissipated);
+  }
+  if (contact_) {
+    j.add("contact_search_time", contact_->search_seconds());
+    j.add("contact_searches", contact_->searches());
+    j.add("contact_dcr_time", contact_->dcr_seconds());
+    j.add("contact_surface_triangles", static_cast<long>(contact_->surface().num_triangles()));
+    // The split of the two times above and the work per step (docs/scenes.md).
+    const ContactProfile& cp = contact_->profile();
+    const double steps = std::max(1L, cp.steps);
+    j.add("contact_verlet_time", cp.verlet_seconds);
+    j.add("contact_sweep_time", cp.sweep_seconds);
+    j.add("contact_candidates_per_step", cp.candidates / steps);
+    j.add("contact_pairs_per_step", owned_pairs[2] / steps);
+    j.add("contact_detections_per_step", cp.detections / steps);
+    j.add("contact_sweeps_per_step", cp.sweeps / steps);
+    if (dec_->distributed()) {
+      j.add("contact_pairs_per_step_rank_min", owned_pairs[0] / steps);
+      j.add("contact_pairs_per_step_rank_max", owned_pairs[1] / steps);
+      j.add("contact_exchange_time", cp.exchange_seconds);
+      j.add("contact_exchange_bytes_per_step", cp.exchange_bytes / steps);
+      j.add("contact_repartitions", cp.repartitions);
+    }
+  }
+  j.write(opt_.out_dir / "summary.json");
+}
+
+}  // namespace shatter

@@ -1,0 +1,101 @@
+// Simulation: the state between two steps (SimulationState), saved every
+// step as the last good state, restored for --restart, written as a
+// checkpoint (runtime/checkpoint.hpp).
+#include <algorithm>
+
+#include "kernels/error.hpp"
+#include "runtime/checkpoint.hpp"
+#include "runtime/contact_stage.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/fracture_stage.hpp"
+#include "runtime/simulation.hpp"
+
+namespace shatter {
+
+void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason) {
+  if (dec_->distributed()) {
+    // Every node's values from its owner; reactions through a nodal array.
+    std::vector<Vec3> reaction(model_.mesh.num_nodes(), Vec3::Zero());
+    for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction[bc_nodes_[b]] = s.reaction[b];
+    const std::span<Vec3> arrays[] = {s.x, s.v, s.a, s.f_int, s.f_ext, reaction};
+    dec_->gather_to_root(arrays);
+    for (size_t b = 0; b < bc_nodes_.size(); ++b) s.reaction[b] = reaction[bc_nodes_[b]];
+  }
+  std::string failure;
+  if (dec_->rank() == 0) try {
+      write_checkpoint(path, model_, s, reason);
+    } catch (const Error& e) {
+      failure = e.what();
+    }
+  if (dec_->max(failure.empty() ? 0 : 1)) throw Error(failure.empty() ? "writing the checkpoint failed on rank 0" : failure);
+}
+
+void Simulation::save_state(SimulationState& s) const {
+  s.step = step_;
+  s.time = time_;
+  s.dt = dt_;
+  s.stable_dt = stable_dt_;
+  s.step_control = step_control_;
+  // Every step saves the state before it (the last good state of a failure): only the nodes
+  // this rank touches, in parallel; a checkpoint takes each node from its owner.
+  const Index n = model_.mesh.num_nodes();
+  for (auto* a : {&s.x, &s.v, &s.a, &s.f_int, &s.f_ext}) a->resize(n);
+  dec_->for_touched(n, [&](Index i) {
+    s.x[i] = x_[i];
+    s.v[i] = v_[i];
+    s.a[i] = a_[i];
+    s.f_int[i] = f_int_[i];
+    s.f_ext[i] = f_ext_[i];
+  });
+  s.reaction = reaction_;
+  s.ledger = ledger_;
+  s.total0 = total0_;
+  s.energy_scale = energy_scale_;
+  s.model_fingerprint = model_fingerprint_;
+  s.model_nodes = model_nodes_;
+  if (fracture_) {
+    if (!s.fracture) s.fracture.emplace();
+    fracture_->save(*s.fracture);
+  } else {
+    s.fracture.reset();
+  }
+}
+
+void Simulation::restore_state(const SimulationState& s) {
+  SHATTER_REQUIRE(!fracture_ == !s.fracture, "restore_state: the state " << (s.fracture ? "has" : "has no")
+                                              << " fracture part, the scene " << (fracture_ ? "has" : "has no")
+                                              << " fracture");
+  if (fracture_) {
+    // The mesh after splits, as grow_nodes left it; bc nodes stay in node
+    // order, since split copies are appended in creation order.
+    const std::uint64_t built_revision = model_.mesh.revision;
+    fracture_->restore(*s.fracture);
+    node_arrays_from_model();
+    dec_->rebuild_nodes();
+    if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
+    share_plans();
+  }
+  const size_t n = model_.mesh.num_nodes();
+  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
+                      s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
+                  "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
+                                                  << " reactions, the model " << n << " and " << bc_nodes_.size());
+  step_ = s.step;
+  time_ = s.time;
+  dt_ = s.dt;
+  stable_dt_ = s.stable_dt;
+  step_control_ = s.step_control;
+  x_ = s.x;
+  v_ = s.v;
+  a_ = s.a;
+  f_int_ = s.f_int;
+  f_ext_ = s.f_ext;
+  reaction_ = s.reaction;
+  ledger_ = s.ledger;
+  total0_ = s.total0;
+  energy_scale_ = s.energy_scale;
+  last_elements_.stable_dt = s.stable_dt;
+  restored_ = true;
+}
+
+}  // namespace shatter
