@@ -28,11 +28,8 @@ void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
   const bool root = dec_->rank() == 0;
   // The fragments' element ids: topology, the same on every rank.
-  std::optional<Fragments> frags;
-  if (fracture_) {
-    frags = fracture_->fragment_labels();
-    ledger_.fragments = frags->count();
-  }
+  const Fragments* frags = fracture_ ? &fracture_->fragment_labels() : nullptr;
+  if (frags) ledger_.fragments = frags->count();
   const Ledger& l = ledger_;
   if (root) {
     *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
@@ -147,7 +144,7 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
 
 CrackArea Simulation::write_fragments() {
   // Each rank sums its owned nodes and elements, exactly; rank 0 adds the ranks' sums.
-  Fragments frags = fracture_->fragment_labels();
+  Fragments frags = fracture_->fragment_labels();  // a copy: the statistics are added to it
   std::vector<ExactSum> sums = fragment_sums(model_.mesh, frags, dec_->owned_nodes(), dec_->owned_element_ids(), x_,
                                              v_, model_.mass);
   if (dec_->distributed()) reduce_to_root(sums, dec_->comm());
