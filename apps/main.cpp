@@ -145,7 +145,7 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
     // Before the meshing: a folder that cannot take the outputs is bad input.
     if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
-    model = build_model(scene);
+    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF);
     sim = std::make_unique<Simulation>(*model, opt);
     if (!restart.empty()) {
       CheckpointRun written;
