@@ -50,6 +50,12 @@ void print_check(const Model& model, const Simulation& sim) {
   for (double m : model.body_mass) mass += m;
   std::printf("total: %d nodes, %d elements (TET%d), mass %.6e kg\n", mesh.num_nodes(), mesh.num_elements(),
               mesh.nodes_per_element(), mass);
+  if (mesh.order == 2) {
+    const MeshScaledJacobian worst = min_scaled_jacobian(mesh);
+    std::printf("TET10 minimum scaled Jacobian %.4f (element %lld; det J / (6 x volume) at the quadrature points, 1 "
+                "for straight-sided elements, valid above 0)\n",
+                worst.value, static_cast<long long>(worst.element));
+  }
   const double dt = s.fixed_dt ? *s.fixed_dt : sim.stable_dt();
   std::printf("stable dt %.4e s (safety %.2f)%s; dt used %.4e s\n", sim.stable_dt() / s.safety, s.safety,
               s.fixed_dt && *s.fixed_dt > sim.stable_dt() ? "  WARNING: time.dt is above it" : "", dt);
@@ -139,7 +145,7 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
     // Before the meshing: a folder that cannot take the outputs is bad input.
     if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
-    model = build_model(scene);
+    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF);
     sim = std::make_unique<Simulation>(*model, opt);
     if (!restart.empty()) {
       CheckpointRun written;

@@ -10,11 +10,15 @@
 #       tets per rank (default 2000), to 2e-4 s (the boxes meet after 5e-5 s):
 #       balance of elements and contact pairs and bytes per rank per step from
 #       summary.json (times are meaningless when oversubscribed).
+#   bench/mpi_scaling.sh BUILD memory [ELEMENTS] [MAX_RANKS]
+#       one box of ELEMENTS tets (default 2000000) on R = 1, 2, 4, ... MAX_RANKS
+#       (default 8) ranks, 20 steps: each rank's peak memory and the bytes of
+#       the arrays a rank holds in the loop (summary.json), against one rank.
 #
 # Results: bench/results/mpi_scaling_<mode>.csv
 set -euo pipefail
-build=${1:?usage: mpi_scaling.sh BUILD strong|weak ...}
-mode=${2:?strong or weak}
+build=${1:?usage: mpi_scaling.sh BUILD strong|weak|memory ...}
+mode=${2:?strong, weak or memory}
 here=$(cd "$(dirname "$0")" && pwd)
 shatter="$build/apps/shatter"
 # Binding (strong runs): a rank of one thread is bound to a core (--bind-to core):
@@ -80,6 +84,23 @@ if [ "$mode" = strong ]; then
     read -r median dir lo hi <<< "$(printf '%s' "${runs[$1x$2]}" | sort -g |
       awk '{w[NR] = $1; d[NR] = $2} END {m = int((NR + 1) / 2); print w[m], d[m], w[1], w[NR]}')"
     echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$lo,$hi,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time)" | tee -a "$out"
+  done
+elif [ "$mode" = memory ]; then
+  elements=${3:-2000000}
+  max_ranks=${4:-8}
+  h=$(size_for "$elements")
+  out="$here/results/mpi_scaling_memory.csv"
+  echo "ranks,elements,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB" > "$out"
+  r=1
+  while [ "$r" -le "$max_ranks" ]; do
+    dir="$work/memory$r"
+    # Twenty steps of the left box alone (the second body is dropped).
+    "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet \
+      --set "contact=null" --set "bodies=[{name: box, material: seed, mesh: {shape: box, size: [1.0, 1.0, 1.0], element_size: $h}, initial_velocity: [20.0, 0.0, 0.0]}]" \
+      --set time.end=1.0e-9 --set time.dt=5.0e-11
+    peaks=$(grep -o '"peak_memory_bytes_per_rank": \[[^]]*\]' "$dir/summary.json" | sed 's/.*\[//; s/\]//')
+    echo "$r,$(key "$dir" elements),$(echo "$peaks" | tr ',' '\n' | awk 'NR == 1 {printf "%.0f", $1 / 1e6}'),$(echo "$peaks" | tr ',' '\n' | awk 'NR > 1 && $1 > m {m = $1} END {printf "%.0f", m / 1e6}'),$(echo "$peaks" | tr ',' '\n' | awk '{s += $1} END {printf "%.0f", s / 1e6}'),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
+    r=$((r * 2))
   done
 else
   per_rank=${3:-2000}

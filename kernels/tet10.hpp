@@ -79,6 +79,25 @@ inline Tet10Reference tet10_reference(const Tet10Nodes& X) {
   return r;
 }
 
+/// The smallest scaled Jacobian of a TET10 over its quadrature points:
+/// det(dX/dxi) / (6 V), V = the element's volume (sum of w det J). The mean
+/// of det J over the reference tetrahedron (volume 1/6) is 6 V, so a
+/// straight-sided element has 1 at every point, a curved one less where it
+/// is squeezed, and <= 0 where its curved edges fold it. Meaningful for V > 0.
+struct Tet10ScaledJacobian {
+  double value;  ///< smallest det J / (6 V), dimensionless
+  int point;     ///< its quadrature point (index into tet10_quadrature_points())
+};
+
+inline Tet10ScaledJacobian tet10_min_scaled_jacobian(const Tet10Reference& r) {
+  Tet10ScaledJacobian s{HUGE_VAL, 0};
+  for (int q = 0; q < 4; ++q) {
+    const double scaled = r.wdetJ[q] / kTet10QuadratureWeight / (6.0 * r.volume);
+    if (scaled < s.value) s = {scaled, q};
+  }
+  return s;
+}
+
 /// Internal nodal forces dE/dx (columns = nodes), strain energy (J) and the
 /// smallest det F over the quadrature points.
 struct Tet10Force {

@@ -1,12 +1,11 @@
 #pragma once
-// Meshes through the Gmsh API: primitive shapes meshed with a target element
-// size and order, and .msh files (formats 2.x and 4.1) read by Gmsh itself after our own scan
-// of their element types.
-#include <cstddef>
+// Primitive shapes meshed through the Gmsh API with a target element size
+// and order. Mesh files: mesh/mesh_file.hpp.
 #include <string>
 #include <vector>
 
 #include "mesh/mesh.hpp"
+#include "mesh/mesh_file.hpp"
 
 namespace shatter {
 
@@ -30,30 +29,5 @@ struct ShapeSpec {
 
 /// Mesh a primitive shape; all nodes and elements get `body` and `material`.
 Mesh mesh_shape(const ShapeSpec& spec, int body, int material, const std::string& where);
-
-/// One element type of a .msh file's $Elements sections.
-struct MshElementType {
-  int type = 0;               ///< Gmsh element type (4 = TET4, 11 = TET10, ...)
-  int nodes = 0;              ///< nodes per element
-  bool tetrahedron = false;   ///< a tetrahedron of any order
-  std::size_t count = 0;      ///< elements of this type in the file
-  std::size_t first_tag = 0;  ///< tag of the first one
-};
-
-/// The element types of a Gmsh .msh file, read by our own scan of its
-/// $Elements sections, not by Gmsh (Gmsh 4.8 corrupts its heap on a volume
-/// holding tetrahedra of two orders, docs/errors.md): formats 2.x and 4.1,
-/// ASCII and binary (either byte order), sections walked as Gmsh walks them.
-/// Types in order of first appearance. Throws InputError naming `where` and
-/// the file when it is not a .msh file of those formats, or its sections are
-/// cut short or malformed.
-std::vector<MshElementType> scan_msh_elements(const std::string& path, const std::string& where);
-
-/// Read the tetrahedra of a Gmsh file (all of them, or those of the physical
-/// volume named `physical` when it is not empty), as TET4 or TET10. The file
-/// is scanned first (scan_msh_elements) and refused, before Gmsh reads it,
-/// when it holds tetrahedra of more than one order.
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material,
-              const std::string& where);
 
 }  // namespace shatter

@@ -1,6 +1,7 @@
 #include "mesh/mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "kernels/error.hpp"
@@ -39,6 +40,24 @@ void append_mesh(Mesh& a, const Mesh& b) {
   a.build_node_elements();
 }
 
+Tet10ScaledJacobian element_min_scaled_jacobian(const Mesh& mesh, Index e) {
+  SHATTER_ASSERT(mesh.order == 2);
+  Tet10Nodes X;
+  for (int a = 0; a < 10; ++a) X.col(a) = mesh.reference[mesh.element(e)[a]];
+  return tet10_min_scaled_jacobian(tet10_reference(X));
+}
+
+MeshScaledJacobian min_scaled_jacobian(const Mesh& mesh) {
+  MeshScaledJacobian worst;
+  if (mesh.order != 2) return worst;
+  worst.value = HUGE_VAL;
+  for (Index e = 0; e < mesh.num_elements(); ++e) {
+    const double value = element_min_scaled_jacobian(mesh, e).value;
+    if (value < worst.value) worst = {value, mesh.elem_gid[e]};
+  }
+  return worst;
+}
+
 double element_reference_volume(const Mesh& mesh, Index e) {
   const Index* c = mesh.element(e);
   if (mesh.order == 1)
@@ -72,17 +91,27 @@ void validate_mesh(const Mesh& mesh, const std::string& where) {
       for (int b = a + 1; b < 4; ++b)
         lmax = std::max(lmax, (mesh.reference[c[a]] - mesh.reference[c[b]]).norm());
     const double vol = element_reference_volume(mesh, e);
-    bool bad = !(vol > 1e-12 * lmax * lmax * lmax);
-    if (mesh.order == 2 && !bad) {
-      Tet10Nodes X;
-      for (int a = 0; a < 10; ++a) X.col(a) = mesh.reference[c[a]];
-      bad = !(tet10_reference(X).min_jacobian > 0);
-    }
-    if (bad) {
+    if (!(vol > 1e-12 * lmax * lmax * lmax)) {
       std::ostringstream os;
       os << "element " << mesh.elem_gid[e] << " is " << (vol < 0 ? "inverted" : "of zero volume")
          << " (volume " << vol << " m^3); expected positive volume with Gmsh node order";
       fail(os.str());
+    }
+    if (mesh.order == 2) {
+      const Tet10ScaledJacobian s = element_min_scaled_jacobian(mesh, e);
+      if (!(s.value > 0)) {
+        Tet10Nodes X;
+        for (int a = 0; a < 10; ++a) X.col(a) = mesh.reference[c[a]];
+        const Vec3 at = X * tet10_shape(tet10_quadrature_points()[s.point]);
+        std::ostringstream os;
+        os << "element " << mesh.elem_gid[e] << " (10-node, volume " << vol
+           << " m^3) has a non-positive Jacobian at its quadrature point near (" << at.x() << ", " << at.y() << ", "
+           << at.z() << "): det J / (6 x volume) = " << s.value
+           << " (1 for a straight-sided element): its curved edges fold it; expected det J > 0 at every "
+              "quadrature point: remesh with Gmsh's Mesh.HighOrderOptimize = 2 (elastic + optimisation), or "
+              "with straight-sided second-order elements (Mesh.SecondOrderLinear = 1)";
+        fail(os.str());
+      }
     }
   }
   for (Index i = 0; i < mesh.num_nodes(); ++i)

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/tet10.hpp"
 #include "kernels/types.hpp"
 
 namespace shatter {
@@ -47,9 +48,22 @@ struct Mesh {
 /// Validate each body's mesh before appending, so errors name the file's tags.
 void append_mesh(Mesh& a, const Mesh& b);
 
-/// Check a mesh for inverted or zero-volume elements and unused nodes; throws
-/// InputError naming `where` (file/key) and the first offending element or node.
+/// Check a mesh for inverted or zero-volume elements, TET10s folded by their
+/// curved edges (a scaled Jacobian <= 0 at a quadrature point,
+/// tet10_min_scaled_jacobian) and unused nodes; throws InputError naming
+/// `where` (file/key) and the first offending element or node.
 void validate_mesh(const Mesh& mesh, const std::string& where);
+
+/// The smallest scaled Jacobian of TET10 element e (tet10_min_scaled_jacobian).
+Tet10ScaledJacobian element_min_scaled_jacobian(const Mesh& mesh, Index e);
+
+/// The smallest scaled Jacobian over a TET10 mesh and the global id of its
+/// element; value 1 and element -1 for a TET4 mesh (straight-sided).
+struct MeshScaledJacobian {
+  double value = 1;
+  GlobalId element = -1;
+};
+MeshScaledJacobian min_scaled_jacobian(const Mesh& mesh);
 
 /// Signed reference volume of element e (for TET10: integral of det(dX/dxi)).
 double element_reference_volume(const Mesh& mesh, Index e);

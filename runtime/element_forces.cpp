@@ -263,20 +263,5 @@ void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e
   o[0] = s(0, 0), o[1] = s(1, 1), o[2] = s(2, 2), o[3] = s(1, 2), o[4] = s(0, 2), o[5] = s(0, 1);
 }
 
-void element_stresses(const Model& model, std::span<const Vec3> x, std::vector<double>& stress6,
-                      std::vector<double>& von_mises_out) {
-  const Index ne = model.mesh.num_elements();
-  stress6.resize(static_cast<size_t>(ne) * 6);
-  von_mises_out.resize(ne);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, ne, 1024), [&](const tbb::blocked_range<Index>& r) {
-    for (Index e = r.begin(); e < r.end(); ++e) {
-      double* o = stress6.data() + 6 * static_cast<size_t>(e);
-      element_cauchy_stress6(model, x, e, o);
-      Mat3 s;
-      s << o[0], o[5], o[4], o[5], o[1], o[3], o[4], o[3], o[2];
-      von_mises_out[e] = von_mises(s);
-    }
-  });
-}
 
 }  // namespace shatter

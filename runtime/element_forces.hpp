@@ -106,8 +106,5 @@ ElementStep element_stable_step(const Model& model, std::span<const Vec3> x, Ind
 /// Voigt components xx yy zz yz xz xy (Pa) written to out[0..5].
 void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e, double* out);
 
-/// element_cauchy_stress6 and the von Mises stress of every element.
-void element_stresses(const Model& model, std::span<const Vec3> x, std::vector<double>& stress6,
-                      std::vector<double>& von_mises_out);
 
 }  // namespace shatter

@@ -74,7 +74,16 @@ Index FractureStage::release(std::span<const Vec3> x) {
   if (cohesive_.size() == 0) return 0;
   const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_, x);
   released_ += freed;  // freed facets exert no force: the eigenvalue bound's key changes
+  if (freed > 0) ++facet_revision_;
   return freed;
+}
+
+const Fragments& FractureStage::fragment_labels() const {
+  if (labels_revision_ != facet_revision_) {
+    labels_ = label_fragments(model_.mesh, topology_);
+    labels_revision_ = facet_revision_;
+  }
+  return labels_;
 }
 
 void FractureStage::save(FractureState& s) const {
@@ -136,6 +145,7 @@ void FractureStage::restore(const FractureState& s) {
   model_.bc_velocity = s.bc_velocity;
   model_.initial_velocity = s.initial_velocity;
   topology_.facet_state = s.facet_state;
+  ++facet_revision_;
   cohesive_ = s.cohesive;
   bound_key_ = {-1, -1, -1};  // the cohesive elements changed: compute the bound afresh
 }

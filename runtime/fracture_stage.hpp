@@ -82,8 +82,10 @@ class FractureStage {
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
-  /// The fragments' element ids and count (no statistics: no positions needed).
-  Fragments fragment_labels() const { return label_fragments(model_.mesh, topology_); }
+  /// The fragments' element ids and count (no statistics: no positions
+  /// needed). Recomputed (label_fragments, O(elements + facets)) only after
+  /// facets were freed or the state restored: nothing else changes them.
+  const Fragments& fragment_labels() const;
   Index cohesive_count() const { return cohesive_.size(); }
   /// The crack surface (crack_area) with the fragments `frags` of the current state.
   CrackArea crack_area(const Fragments& frags) const {
@@ -109,6 +111,9 @@ class FractureStage {
   CohesiveElements cohesive_;
   std::vector<std::optional<CohesiveLaw>> laws_;
   double check_seconds_ = 0;
+  long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
+  mutable Fragments labels_;
+  mutable long labels_revision_ = -1;  ///< facet_revision_ of labels_
   double eigenvalue_bound_ = 0;  ///< cached cohesive bound, 1/s^2
   Index released_ = 0;           ///< cohesive elements freed by release() so far
   /// (cohesive count, node count, released_) the bound was computed for: what

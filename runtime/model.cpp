@@ -7,33 +7,75 @@
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
 #include "mesh/reorder.hpp"
+#include "runtime/mesh_broadcast.hpp"
 
 namespace shatter {
 
-Model build_model(const Scene& scene) {
-  Model m;
-  m.scene = scene;
-  for (const auto& ms : scene.materials)
-    m.materials.push_back(NeoHookean::from_young_poisson(ms.young, ms.poisson, ms.density));
+namespace {
 
+/// Every body meshed (or read) and checked, appended in order, the elements
+/// along a space-filling curve.
+Mesh mesh_bodies(const Scene& scene) {
+  Mesh mesh;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
     const std::string where = scene.file + ": " + body.key + ".mesh" +
                               (body.mesh_file.empty() ? "" : " (" + body.mesh_file + ")");
     Mesh part = body.mesh_file.empty()
                     ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
-                    : read_msh(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
+                    : read_mesh_file(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
     validate_mesh(part, where);
-    if (m.mesh.num_elements() > 0 && part.order != m.mesh.order)
+    if (mesh.num_elements() > 0 && part.order != mesh.order)
       throw InputError(where + ": element order " + std::to_string(part.order) +
                        " differs from the first body's; expected one order for all bodies");
-    append_mesh(m.mesh, part);
+    append_mesh(mesh, part);
   }
-
   // Elements along a space-filling curve, nodes by first use: the colored
   // element loop needs consecutive elements to share nodes (3x faster than
   // Gmsh's order, and 15 colors instead of 280; docs/performance.md).
-  reorder_for_locality(m.mesh, GlobalIdPolicy::keep);
+  reorder_for_locality(mesh, GlobalIdPolicy::keep);
+  return mesh;
+}
+
+/// mesh_bodies on rank 0 of `comm`, broadcast to the others; a failure there
+/// is thrown on every rank (InputError stays InputError), so the ranks end
+/// together.
+Mesh mesh_on_root(const Scene& scene, MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  Mesh mesh;
+  std::string error;
+  int kind = 0;  // 0 none, 1 Error, 2 InputError
+  if (rank == 0) try {
+      mesh = mesh_bodies(scene);
+    } catch (const InputError& e) {
+      error = e.what(), kind = 2;
+    } catch (const std::exception& e) {
+      error = e.what(), kind = 1;
+    }
+  int head[2] = {kind, static_cast<int>(error.size())};
+  MPI_Bcast(head, 2, MPI_INT, 0, comm);
+  if (head[0] != 0) {
+    error.resize(head[1]);
+    MPI_Bcast(error.data(), head[1], MPI_CHAR, 0, comm);
+    if (head[0] == 2) throw InputError(error);
+    throw Error(error);
+  }
+  broadcast_mesh(mesh, 0, comm);
+  return mesh;
+}
+
+}  // namespace
+
+Model build_model(const Scene& scene, MPI_Comm comm) {
+  Model m;
+  m.scene = scene;
+  for (const auto& ms : scene.materials)
+    m.materials.push_back(NeoHookean::from_young_poisson(ms.young, ms.poisson, ms.density));
+  int ranks = 1;
+  if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
+  m.mesh = ranks > 1 ? mesh_on_root(scene, comm) : mesh_bodies(scene);
+
   const Mesh& mesh = m.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();

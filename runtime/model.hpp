@@ -2,6 +2,8 @@
 // The model a scene describes: one mesh holding every body, the materials,
 // the per-element reference constants, lumped masses, boundary conditions
 // and initial velocities. Built once, before the run.
+#include <mpi.h>
+
 #include <cstdint>
 #include <vector>
 
@@ -33,8 +35,11 @@ struct Model {
 };
 
 /// Mesh every body, check the meshes, and compute every constant of the model.
-/// Throws InputError (bad scene or mesh).
-Model build_model(const Scene& scene);
+/// On several ranks of `comm` (collective) rank 0 meshes and sends the mesh
+/// to the others, which compute the constants from it: Gmsh runs once, and
+/// every rank holds the same model. Throws InputError (bad scene or mesh) on
+/// every rank.
+Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF);
 
 /// Recompute the lumped masses of `nodes` from element_node_mass (after node splitting).
 void recompute_node_masses(Model& model, const std::vector<Index>& nodes);

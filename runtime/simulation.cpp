@@ -38,7 +38,8 @@ Simulation::Simulation(Model& model, RunOptions options)
   const Mesh& mesh = model_.mesh;
   model_fingerprint_ = model_fingerprint(model_);
   if (dec_->distributed()) {
-    // Every rank meshed the scene itself: check that they agree.
+    // The ranks' models must be one: the CLI builds them from rank 0's mesh
+    // (build_model on the world); a caller that meshed on every rank may not.
     std::uint64_t fp[2] = {model_fingerprint_, ~model_fingerprint_};
     MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, dec_->comm());
     if (fp[0] != ~fp[1])

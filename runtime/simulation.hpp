@@ -223,9 +223,10 @@ class Simulation {
   /// Writes fragments.csv from rank 0 (collective); returns the crack surface
   /// between those fragments on rank 0, zeros elsewhere.
   CrackArea write_fragments();
-  /// x and v of every node on rank 0 (for the field frames): the own arrays
-  /// on one rank, else gathered from the owners into `x` and `v` (collective).
-  std::array<std::span<const Vec3>, 2> root_state(std::vector<Vec3>& x, std::vector<Vec3>& v);
+  /// A field frame, written collectively: each rank sends its owned nodes' and
+  /// elements' rows to its block of the global order (row_blocks.hpp).
+  /// `elem_fragment`: fragment ids per element (fracture; empty otherwise).
+  void write_fields(std::span<const Index> elem_fragment);
 };
 
 }  // namespace shatter

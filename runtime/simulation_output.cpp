@@ -8,7 +8,9 @@
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/global_sum.hpp"
+#include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
+#include "runtime/row_blocks.hpp"
 #include "runtime/simulation.hpp"
 #include "runtime/timed.hpp"
 
@@ -22,24 +24,12 @@ struct BodyRow {
 
 }  // namespace
 
-std::array<std::span<const Vec3>, 2> Simulation::root_state(std::vector<Vec3>& x, std::vector<Vec3>& v) {
-  if (!dec_->distributed()) return {x_, v_};
-  x = x_;
-  v = v_;
-  const std::span<Vec3> arrays[] = {x, v};
-  dec_->gather_to_root(arrays);
-  return {x, v};
-}
-
 void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
   const bool root = dec_->rank() == 0;
   // The fragments' element ids: topology, the same on every rank.
-  std::optional<Fragments> frags;
-  if (fracture_) {
-    frags = fracture_->fragment_labels();
-    ledger_.fragments = frags->count();
-  }
+  const Fragments* frags = fracture_ ? &fracture_->fragment_labels() : nullptr;
+  if (frags) ledger_.fragments = frags->count();
   const Ledger& l = ledger_;
   if (root) {
     *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
@@ -74,43 +64,87 @@ void Simulation::write_outputs(bool fields) {
     bodies_->end_row();
   }
 
-  if (fields && fields_) {
-    // Rank 0 writes every row (from the owners' values); the others take
-    // part in the collective writes with none.
-    std::vector<Vec3> x_all, v_all;
-    const std::array<std::span<const Vec3>, 2> xv = root_state(x_all, v_all);
-    std::vector<Vec3> u;
-    std::vector<double> stress, vm;
-    FieldFrame f;
-    f.step = static_cast<int>(step_);
-    f.time = time_;
-    Mesh empty;
-    empty.order = mesh.order;
-    std::vector<int> fragment_id;
-    std::vector<double> damage;
-    if (root) {
-      element_stresses(model_, xv[0], stress, vm);
-      u.resize(mesh.num_nodes());
-      for (Index i = 0; i < mesh.num_nodes(); ++i) u[i] = xv[0][i] - mesh.reference[i];
-      f.displacement = u;
-      f.velocity = xv[1];
-      f.stress = stress;
-      f.von_mises = vm;
-      f.body = mesh.elem_body;
-      if (frags) {
-        fragment_id.assign(frags->elem_fragment.begin(), frags->elem_fragment.end());
-        f.fragment = fragment_id;
-        damage = fracture_->damage();
-        f.damage = damage;
-      }
-    }
-    fields_->write(root ? mesh : empty, f);
+  if (fields && fields_) write_fields(frags ? frags->elem_fragment : std::span<const Index>{});
+}
+
+void Simulation::write_fields(std::span<const Index> elem_fragment) {
+  // Each rank packs its owned nodes and elements; the rows move to
+  // contiguous blocks in global order (row_blocks.hpp), which each rank
+  // writes collectively: the file is the same for any decomposition, and no
+  // rank gathers the model.
+  const Mesh& mesh = model_.mesh;
+  const int k = mesh.nodes_per_element();
+  const bool cracks = !elem_fragment.empty();
+  const std::span<const Index> nodes = dec_->owned_nodes(), elems = dec_->owned_element_ids();
+  constexpr int kNodeWidth = 9;  // X, u, v
+  std::vector<double> node_rows(nodes.size() * kNodeWidth);
+  parallel_for_each(static_cast<Index>(nodes.size()), [&](Index r) {
+    const Index i = nodes[r];
+    double* o = node_rows.data() + static_cast<size_t>(r) * kNodeWidth;
+    const Vec3 u = x_[i] - mesh.reference[i];
+    for (int c = 0; c < 3; ++c) o[c] = mesh.reference[i][c], o[3 + c] = u[c], o[6 + c] = v_[i][c];
+  });
+  // Per element: connectivity, stress (6), von Mises, body, and with fracture fragment and damage.
+  const int width = k + 9 + (cracks ? 2 : 0);
+  const std::vector<double> damage = cracks ? fracture_->damage() : std::vector<double>{};
+  std::vector<double> elem_rows(elems.size() * width);
+  parallel_for_each(static_cast<Index>(elems.size()), [&](Index r) {
+    const Index e = elems[r];
+    double* o = elem_rows.data() + static_cast<size_t>(r) * width;
+    for (int a = 0; a < k; ++a) o[a] = mesh.element(e)[a];
+    double* s6 = o + k;
+    element_cauchy_stress6(model_, x_, e, s6);
+    Mat3 sigma;
+    sigma << s6[0], s6[5], s6[4], s6[5], s6[1], s6[3], s6[4], s6[3], s6[2];
+    o[k + 6] = von_mises(sigma);
+    o[k + 7] = mesh.elem_body[e];
+    if (cracks) o[k + 8] = elem_fragment[e], o[k + 9] = damage[e];
+  });
+  const MPI_Comm comm = dec_->distributed() ? dec_->comm() : MPI_COMM_SELF;
+  const std::vector<double> nb = to_row_blocks(nodes, node_rows, kNodeWidth, mesh.num_nodes(), comm);
+  const std::vector<double> eb = to_row_blocks(elems, elem_rows, width, mesh.num_elements(), comm);
+
+  // This rank's block as a mesh (connectivity in global node rows) and frame.
+  const size_t bn = nb.size() / kNodeWidth, be = eb.size() / width;
+  Mesh block;
+  block.order = mesh.order;
+  block.revision = mesh.revision;
+  block.reference.resize(bn);
+  std::vector<Vec3> u(bn), v(bn);
+  for (size_t r = 0; r < bn; ++r) {
+    const double* o = nb.data() + r * kNodeWidth;
+    block.reference[r] = Vec3(o[0], o[1], o[2]);
+    u[r] = Vec3(o[3], o[4], o[5]);
+    v[r] = Vec3(o[6], o[7], o[8]);
   }
+  block.conn.resize(be * k);
+  block.elem_gid.resize(be);
+  std::vector<double> stress(6 * be), vm(be), block_damage(cracks ? be : 0);
+  std::vector<int> body(be), fragment(cracks ? be : 0);
+  for (size_t r = 0; r < be; ++r) {
+    const double* o = eb.data() + r * width;
+    for (int a = 0; a < k; ++a) block.conn[r * k + a] = static_cast<Index>(o[a]);
+    std::copy_n(o + k, 6, stress.begin() + 6 * r);
+    vm[r] = o[k + 6];
+    body[r] = static_cast<int>(o[k + 7]);
+    if (cracks) fragment[r] = static_cast<int>(o[k + 8]), block_damage[r] = o[k + 9];
+  }
+  FieldFrame f;
+  f.step = static_cast<int>(step_);
+  f.time = time_;
+  f.displacement = u;
+  f.velocity = v;
+  f.stress = stress;
+  f.von_mises = vm;
+  f.body = body;
+  f.fragment = fragment;
+  f.damage = block_damage;
+  fields_->write(block, f);
 }
 
 CrackArea Simulation::write_fragments() {
   // Each rank sums its owned nodes and elements, exactly; rank 0 adds the ranks' sums.
-  Fragments frags = fracture_->fragment_labels();
+  Fragments frags = fracture_->fragment_labels();  // a copy: the statistics are added to it
   std::vector<ExactSum> sums = fragment_sums(model_.mesh, frags, dec_->owned_nodes(), dec_->owned_element_ids(), x_,
                                              v_, model_.mass);
   if (dec_->distributed()) reduce_to_root(sums, dec_->comm());

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <numbers>
 #include <sstream>
 
@@ -15,16 +14,11 @@
 #include "kernels/error.hpp"
 #include "kernels/tet10.hpp"
 #include "mesh/gmsh_input.hpp"
+#include "mesh/mesh_test_helpers.hpp"
 
 using namespace shatter;
-
-namespace {
-double total_volume(const Mesh& m) {
-  double v = 0;
-  for (Index e = 0; e < m.num_elements(); ++e) v += element_reference_volume(m, e);
-  return v;
-}
-}  // namespace
+using shatter::test::input_error;
+using shatter::test::total_volume;
 
 TEST(GmshInput, BoxVolumeIsExactAndMeshValid) {
   ShapeSpec s;
@@ -280,14 +274,6 @@ std::string write_file(const std::filesystem::path& p, const std::string& bytes)
   return p.string();
 }
 
-std::string input_error(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 }  // namespace
 

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
       if (argc != 5) throw InputError("usage: fail_alone SCENE OUTDIR RANK STEP");
       const int fail_rank = std::atoi(argv[3]);
       const long fail_step = std::atol(argv[4]);
-      model = build_model(load_scene(argv[1], {}));
+      model = build_model(load_scene(argv[1], {}), MPI_COMM_WORLD);
       RunOptions opt;
       opt.out_dir = argv[2];
       opt.ranks = ranks;

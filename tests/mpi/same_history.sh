@@ -1,6 +1,7 @@
 #!/bin/bash
 # The same scene on 1x1, 2x1, 1x2, 3x1 and 4x1 ranks x threads must give the same
-# history.csv and bodies.csv (and fragments.csv), byte for byte (issue 6:
+# history.csv and bodies.csv (and fragments.csv, and fields.h5's datasets when
+# the scene writes frames), byte for byte (issue 6:
 # "bitwise with --deterministic"; the decomposed loop is bitwise for any
 # decomposition, so the flag changes nothing). Also checks that summary.json
 # names the ranks and that the comparison covers what the scene is for:
@@ -32,6 +33,12 @@ for d in r2t1 r1t2 r3t1 r4t1; do
       status=1
     fi
   done
+  # Field frames (when the scene writes them): every dataset the same bits.
+  if [ -f "$work/r1t1/fields.h5" ]; then
+    /usr/bin/python3 "$(dirname "$0")/same_fields.py" "$work/r1t1/fields.h5" "$work/$d/fields.h5" > /dev/null ||
+      { echo "FAIL: $d/fields.h5 differs from r1t1/fields.h5"; status=1; }
+    cmp -s "$work/r1t1/fields.xdmf" "$work/$d/fields.xdmf" || { echo "FAIL: $d/fields.xdmf differs"; status=1; }
+  fi
 done
 grep -q '"ranks": 3' "$work/r3t1/summary.json" || { echo "FAIL: r3t1/summary.json does not say 3 ranks"; status=1; }
 if [ "$kind" = contact ]; then

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "runtime/model.hpp"
 #include "scene_text.hpp"
 
 namespace {
@@ -56,6 +57,28 @@ TEST(BadInput, GoodSceneChecksClean) {
   const auto r = run_shatter("check " + shatter::test::write_scene("good", kGood));
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("stable dt"), std::string::npos) << r.output;
+}
+
+// `shatter check` of order-2 curved shapes: valid (exit 0), and the minimum
+// scaled Jacobian it prints is that of the mesh the model holds.
+TEST(Check, OrderTwoSphereAndTubeReportTheirMinimumScaledJacobian) {
+  const std::string box = "mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}";
+  for (const auto& [name, mesh] :
+       {std::pair{"sphere", "mesh: {shape: sphere, radius: 0.01, element_size: 0.004, order: 2}"},
+        std::pair{"tube", "mesh: {shape: tube, inner_radius: 0.008, outer_radius: 0.01, length: 0.005, "
+                          "element_size: 0.002, order: 2}"}}) {
+    SCOPED_TRACE(name);
+    const std::string yaml = replaced(kGood, box, mesh);
+    const auto r = run_shatter("check " + shatter::test::write_scene(std::string("order2_") + name, yaml));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string key = "TET10 minimum scaled Jacobian ";
+    const size_t at = r.output.find(key);
+    ASSERT_NE(at, std::string::npos) << r.output;
+    const double printed = std::stod(r.output.substr(at + key.size()));
+    const shatter::Model model = shatter::build_model(shatter::test::scene_from_text(name, yaml));
+    EXPECT_NEAR(printed, shatter::min_scaled_jacobian(model.mesh).value, 5e-5);
+    EXPECT_GT(printed, 0.3);
+  }
 }
 
 TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {

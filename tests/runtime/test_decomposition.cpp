@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "mpi_environment.hpp"
+#include "kernels/error.hpp"
+#include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/model.hpp"
@@ -151,6 +153,34 @@ TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
   d.sum({&total, 1});
   EXPECT_EQ(total.value(), whole.strain_energy);
   EXPECT_GT(total.value(), 0.0);
+}
+
+TEST(Decomposition, BuildModelOnSeveralRanksMeshesOnceForAll) {
+  // Rank 0 meshes, every rank gets its mesh: the same model as one built alone.
+  const Scene scene = test::scene_from_text(
+      "build_model_world",
+      "name: world\n"
+      "time: {end: 1.0}\n"
+      "materials:\n"
+      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+      "bodies:\n"
+      "  - name: b\n"
+      "    material: steel\n"
+      "    mesh: {shape: sphere, radius: 0.01, element_size: 0.003, order: 2}\n");
+  const Model world = build_model(scene, MPI_COMM_WORLD);
+  std::uint64_t fp[2] = {model_fingerprint(world), ~model_fingerprint(world)};
+  MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+  EXPECT_EQ(fp[0], ~fp[1]) << "the ranks' models differ";
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0) {
+    EXPECT_EQ(model_fingerprint(build_model(scene)), model_fingerprint(world));
+  }
+  EXPECT_EQ(world.mesh.node_elem.size(), world.mesh.conn.size());
+  // A mesh that fails on rank 0 fails on every rank, as bad input.
+  Scene bad = scene;
+  bad.bodies[0].mesh_file = "/nonexistent/body.msh";
+  EXPECT_THROW(build_model(bad, MPI_COMM_WORLD), InputError);
 }
 
 }  // namespace

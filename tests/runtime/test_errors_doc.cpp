@@ -104,6 +104,19 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
                                       "7 0 0.5 0\n8 0 0 0.5\n9 0 0.5 0.5\n10 0.5 0 0.5\n$EndNodes\n"
                                       "$Elements\n2\n1 4 2 1 1 1 2 3 4\n2 11 2 1 1 1 2 3 4 5 6 7 8 9 10\n"
                                       "$EndElements\n";
+  // The unit corner tet with the mid-edge node of edge 1-2 moved by (0, 0.3, 0.3).
+  std::ofstream(dir / "folded.msh") << header
+                                    << "$Nodes\n10\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0.5 0.3 0.3\n6 0.5 0.5 0\n"
+                                       "7 0 0.5 0\n8 0 0 0.5\n9 0 0.5 0.5\n10 0.5 0 0.5\n$EndNodes\n"
+                                       "$Elements\n1\n3 11 2 1 1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n";
+  std::ofstream(dir / "prisms.msh") << header
+                                    << "$PhysicalNames\n2\n3 1 \"core\"\n3 2 \"layers\"\n$EndPhysicalNames\n"
+                                       "$Nodes\n7\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 -1\n5 0 0 1\n6 1 0 1\n7 0 1 1\n"
+                                       "$EndNodes\n$Elements\n2\n1 4 2 1 1 1 3 2 4\n2 6 2 2 2 1 2 3 5 6 7\n"
+                                       "$EndElements\n";
+  std::ofstream(dir / "model.inp") << "*NODE\n";
+  std::ofstream(dir / "garbage.vtk") << "# vtk DataFile Version 2.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                                        "POINTS 4 double\n0 0\n";
   std::ofstream(dir / "bad_yaml.yaml") << "name: x\ntime: [1, 2\n";
   std::ofstream(dir / "list.yaml") << "- name: x\n- time: 1\n";
   std::ofstream(dir / "not_hdf5.h5") << "this is not a checkpoint\n";

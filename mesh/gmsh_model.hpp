@@ -1,0 +1,51 @@
+#pragma once
+// The Gmsh API's one global model, as the mesh readers use it: a session
+// that serialises and resets it, a file opened into it, and the tetrahedra
+// taken out of it. Internal to shatter::mesh (gmsh_input.cpp, mesh_file.cpp).
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+
+namespace shatter {
+
+/// Exclusive use of the Gmsh model, cleared on entry and exit. Gmsh 4.8
+/// reads nothing more after a failed open or meshing (every later file
+/// comes out empty) until it is initialised again, so a session left by an
+/// exception finalises Gmsh and the next one initialises it.
+class GmshSession {
+ public:
+  GmshSession();
+  ~GmshSession();
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+  int exceptions_;
+};
+
+/// Open a mesh file into the model (Gmsh picks the reader by extension).
+/// A file Gmsh cannot read throws InputError naming `where`, the file, the
+/// format it was read as (`format`, with its article: "a .msh") and Gmsh's last error.
+void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where);
+
+/// The volumes (3D entity tags) of the physical volume named `physical`, or
+/// every volume when it is empty. InputError when no physical volume has
+/// that name.
+std::vector<int> selected_volumes(const std::string& physical, const std::string& where);
+
+/// Refuse volumes that hold elements other than tetrahedra (hexahedra,
+/// prisms, pyramids, ...): an InputError naming the file, each kind's count
+/// and the physical volumes holding it. Counts come from Gmsh's per-family
+/// sizes (preallocateElementsByType), which read no element's nodes.
+void require_tetrahedra_only(const std::vector<int>& volumes, const std::string& path, const std::string& physical,
+                             const std::string& where);
+
+/// The tetrahedra of `order` (1: 4-node, 2: 10-node) in `volumes`, as a Mesh
+/// whose nodes are renumbered densely in order of first use; ids are Gmsh's
+/// tags. InputError when there are none.
+Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int material, const std::string& where);
+
+}  // namespace shatter
