@@ -84,6 +84,14 @@ void validate_mesh(const Mesh& mesh, const std::string& where) {
         fail(os.str());
       }
       used[c[a]] = 1;
+      const Vec3& X = mesh.reference[c[a]];
+      if (!(X.array().abs() <= kMaxCoordinate).all()) {
+        std::ostringstream os;
+        os << "node " << mesh.node_gid[c[a]] << " of element " << mesh.elem_gid[e] << " is at (" << X.x() << ", "
+           << X.y() << ", " << X.z() << "); expected finite coordinates within " << kMaxCoordinate
+           << " m of the origin";
+        fail(os.str());
+      }
     }
     // Scale-aware zero-volume test: volume against the cube of the longest edge.
     double lmax = 0;

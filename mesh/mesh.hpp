@@ -48,7 +48,13 @@ struct Mesh {
 /// Validate each body's mesh before appending, so errors name the file's tags.
 void append_mesh(Mesh& a, const Mesh& b);
 
-/// Check a mesh for inverted or zero-volume elements, TET10s folded by their
+/// The largest magnitude of a node coordinate, m (the Sun's radius is 7e8 m):
+/// beyond it, or not finite, validate_mesh refuses the node, since the volume
+/// test would overflow (1e200) or see NaN and call the element "of zero volume".
+inline constexpr double kMaxCoordinate = 1e9;
+
+/// Check a mesh for nodes of its elements with coordinates not finite or
+/// beyond kMaxCoordinate, inverted or zero-volume elements, TET10s folded by their
 /// curved edges (a scaled Jacobian <= 0 at a quadrature point,
 /// tet10_min_scaled_jacobian) and unused nodes; throws InputError naming
 /// `where` (file/key) and the first offending element or node.

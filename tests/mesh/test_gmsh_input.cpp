@@ -351,3 +351,33 @@ TEST(GmshInput, ScanRefusesWhatItCannotFollow) {
                 .find("holds element 9 of type 777, which is not a Gmsh element type"),
             std::string::npos);
 }
+
+// A node at NaN, inf or 1e200 was reported as an element "of zero volume"
+// (the volume test overflowed or saw NaN): now the node is named, with where
+// it is and the bound (issue 21).
+TEST(GmshInput, NodesBeyondTheCoordinateBoundAreNamed) {
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_msh_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "far.msh").string();
+  std::ofstream(path) << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1e200\n"
+                         "$EndNodes\n$Elements\n1\n5 4 2 1 1 1 2 3 4\n$EndElements\n";
+  Mesh m = read_msh(path, "", 0, 0, "t");
+  for (const double bad : {1e200, -2e9, std::nan(""), HUGE_VAL}) {
+    for (Vec3& X : m.reference)
+      if (X.z() != 0) X.z() = bad;
+    try {
+      validate_mesh(m, "far.msh");
+      FAIL() << "a node at z = " << bad << " accepted";
+    } catch (const InputError& e) {
+      std::ostringstream z;
+      z << bad;
+      EXPECT_NE(std::string(e.what()).find("far.msh: node 4 of element 5 is at (0, 0, " + z.str() +
+                                           "); expected finite coordinates within 1e+09 m of the origin"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // The unit tet moved to z = 1e9 - 1 ... 1e9: within the bound, and valid.
+  for (Vec3& X : m.reference) X.z() = X.z() == 0 ? 1e9 - 1 : 1e9;
+  EXPECT_NO_THROW(validate_mesh(m, "far.msh"));
+}

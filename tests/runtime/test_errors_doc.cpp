@@ -92,6 +92,9 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
   std::ofstream(dir / "flat.msh") << header
                                   << "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n$EndNodes\n"
                                      "$Elements\n1\n7 4 2 1 1 1 2 3 4\n$EndElements\n";
+  std::ofstream(dir / "far.msh") << header
+                                 << "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1e200\n$EndNodes\n"
+                                    "$Elements\n1\n5 4 2 1 1 1 2 3 4\n$EndElements\n";
   std::ofstream(dir / "triangles.msh") << header
                                        << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
                                           "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
