@@ -55,7 +55,7 @@ struct RunOptions {
   /// Called on every rank before each step with the number of the step to
   /// come (null: nothing); what it throws fails the step as the step would
   /// (tests inject failures with it: tests/mpi/fail_alone.cpp).
-  std::function<void(long)> before_step;
+  std::function<void(long)> before_step = nullptr;
 };
 
 /// The complete state of a run between two steps: what a checkpoint holds
