@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -271,6 +272,24 @@ TEST(Scenes, PlotWritesPngs) {
     ASSERT_TRUE(std::filesystem::is_regular_file(path)) << path;
     EXPECT_GT(std::filesystem::file_size(path), 1000u) << path;
   }
+  // A history.csv of a shatter before contact_work (issue 18) is still plotted.
+  {
+    std::ifstream in(out / "history.csv");
+    std::string line, old;
+    while (std::getline(in, line)) {
+      size_t at = 0;
+      for (int comma = 0; comma < 8; ++comma) at = line.find(',', at) + 1;  // the 9th column
+      old += line.erase(at, line.find(',', at) + 1 - at) + "\n";
+    }
+    ASSERT_EQ(old.find("contact_work"), std::string::npos);
+    in.close();
+    std::ofstream(out / "history.csv", std::ios::trunc) << old;
+  }
+  std::filesystem::remove_all(out / "plots");
+  const int old_status = std::system((shatter + " plot " + out.string() + " > /dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(old_status));
+  EXPECT_EQ(WEXITSTATUS(old_status), 0);
+  EXPECT_GT(std::filesystem::file_size(out / "plots" / "energies.png"), 1000u);
   const auto empty = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_plot_empty";
   std::filesystem::create_directories(empty);
   const int missing = std::system((shatter + " plot " + empty.string() + " 2> /dev/null").c_str());
