@@ -21,9 +21,7 @@ namespace shatter {
 
 template <int K, class Term>
 std::array<ExactSum, K> Simulation::granule_sums(Term term) const {
-  std::vector<Index> slots(dec_->owned_granules().size());
-  for (size_t k = 0; k < slots.size(); ++k) slots[k] = static_cast<Index>(k);
-  return exact_sums<K>(slots, [&](Index k, std::array<ExactSum, K>& sums) {
+  return exact_sums<K>(static_cast<Index>(dec_->owned_granules().size()), [&](Index k, std::array<ExactSum, K>& sums) {
     std::array<double, K> partial{};
     for (Index i : dec_->home_nodes(k)) term(i, partial);
     for (int c = 0; c < K; ++c) sums[c] += partial[c];
