@@ -280,7 +280,9 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   if (kind == DcrPairKind::EdgeEdge && V.c0 * V_new > 0.0 && std::abs(V.c0) > tol &&
       std::abs(V.c0) > std::abs(V.c1) + std::abs(V.c2) + std::abs(V.c3))
     return out;
-  PairNormals N;
+  // Filled on first use; zero before that so that N is never read undefined (the flag
+  // alone left GCC unable to prove it, -Wmaybe-uninitialized).
+  PairNormals N = PairNormals::Zero();
   bool have_normals = false;
   auto pair_normals = [&]() -> const PairNormals& {
     if (!have_normals) N = normals();

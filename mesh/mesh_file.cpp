@@ -68,16 +68,35 @@ const std::vector<MeshFileFormat>& mesh_file_formats() {
   return formats;
 }
 
+namespace {
+
+/// `path` opened by Gmsh in a child process that writes the model as a
+/// binary .msh 4.1 (every element, one block per volume and element type);
+/// that copy is then scanned and read here, with messages naming the user's
+/// file. Gmsh 4.8's readers crash on some malformed files (.unv, .vtk, and
+/// binary .msh: tests/fuzz/crashes/); in the child a crash is a refusal.
+Mesh read_through_child(const std::string& path, const char* format, const std::string& physical, int body,
+                        int material, const std::string& where) {
+  GmshSession session;
+  static std::atomic<unsigned> serial{0};
+  const TemporaryFile copy{std::filesystem::temp_directory_path() /
+                           ("shatter_mesh_" + std::to_string(getpid()) + "_" + std::to_string(serial++) + ".msh")};
+  convert_to_msh_in_child(path, format, copy.path.string(), where);
+  const int order = tetrahedron_order(scan_msh_elements(copy.path.string(), where, path), path, where);
+  open_in_gmsh(copy.path.string(), "a .msh", where);
+  return tetrahedra_of_model(order, path, physical, body, material, where);
+}
+
+}  // namespace
+
 Mesh read_msh(const std::string& path, const std::string& physical, int body, int material, const std::string& where) {
   require_file(path, where);
-  // Which tetrahedra the file holds, from our own scan: Gmsh 4.8 lists a
-  // volume's tets by the type of its first one, overrunning its buffers when
-  // the volume holds two orders (docs/errors.md), so such a file never
-  // reaches Gmsh.
-  const int order = tetrahedron_order(scan_msh_elements(path, where), path, where);
-  GmshSession session;
-  open_in_gmsh(path, "a .msh", where);
-  return tetrahedra_of_model(order, path, physical, body, material, where);
+  // Which tetrahedra the file holds, from our own scan first: Gmsh 4.8 lists
+  // a volume's tets by the type of its first one, overrunning its buffers
+  // when the volume holds two orders (docs/errors.md), so such a file is
+  // refused with that reason before Gmsh reads it.
+  tetrahedron_order(scan_msh_elements(path, where), path, where);
+  return read_through_child(path, "a .msh", physical, body, material, where);
 }
 
 Mesh read_mesh_file(const std::string& path, const std::string& physical, int body, int material,
@@ -94,18 +113,7 @@ Mesh read_mesh_file(const std::string& path, const std::string& physical, int bo
                      "'); expected one of " + list + " (docs/scenes.md, \"Mesh files\")");
   }
   require_file(path, where);
-  GmshSession session;
-  // The model as Gmsh writes it (binary .msh 4.1, every element, one block
-  // per volume and element type, whatever the types of its first elements),
-  // read as a user's .msh is: scanned first, the same refusals, before Gmsh
-  // lists any element; messages name the user's file.
-  static std::atomic<unsigned> serial{0};
-  const TemporaryFile copy{std::filesystem::temp_directory_path() /
-                           ("shatter_mesh_" + std::to_string(getpid()) + "_" + std::to_string(serial++) + ".msh")};
-  convert_to_msh_in_child(path, format->name, copy.path.string(), where);
-  const int order = tetrahedron_order(scan_msh_elements(copy.path.string(), where, path), path, where);
-  open_in_gmsh(copy.path.string(), "a .msh", where);
-  return tetrahedra_of_model(order, path, physical, body, material, where);
+  return read_through_child(path, format->name, physical, body, material, where);
 }
 
 }  // namespace shatter

@@ -21,7 +21,8 @@ namespace {
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
 
 constexpr const char* kFormat = "shatter-checkpoint";
-constexpr long kVersion = 3;  // 2: the step controller's state; 3: the scene's physics keys
+// 2: the step controller's state; 3: the scene's physics keys; 4: the ledger's contact_work
+constexpr long kVersion = 4;
 constexpr long kOldestVersion = 2;  // read without the physics check
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
@@ -332,6 +333,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.number(g, "cohesive_stored", l.cohesive_stored);
     w.number(g, "cohesive_dissipated", l.cohesive_dissipated);
     w.number(g, "contact_dissipated", l.contact_dissipated);
+    w.number(g, "contact_work", l.contact_work);
     w.number(g, "external_work", l.external_work);
     const char* p_names[3] = {"px", "py", "pz"};
     const char* L_names[3] = {"Lx", "Ly", "Lz"};
@@ -516,6 +518,9 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   l.cohesive_stored = r.number(g, "cohesive_stored");
   l.cohesive_dissipated = r.number(g, "cohesive_dissipated");
   l.contact_dissipated = r.number(g, "contact_dissipated");
+  // Before version 4 the contact's first-order work was in contact_dissipated (e < 1 or
+  // mu > 0) or in no term (e = 1, mu = 0): it continues from 0, the total stays as it was.
+  l.contact_work = version >= 4 ? r.number(g, "contact_work") : 0.0;
   l.external_work = r.number(g, "external_work");
   const char* p_names[3] = {"px", "py", "pz"};
   const char* L_names[3] = {"Lx", "Ly", "Lz"};

@@ -84,7 +84,8 @@ std::string ledger_diagnosis(double overflow, const Model& model, std::span<cons
   else if (step == 0) os << "beyond " << overflow << " J";
   else os << "beyond " << overflow << " J, an overflow under way";
   os << " (kinetic " << l.kinetic << ", strain " << l.strain << ", cohesive " << l.cohesive_stored << " + "
-     << l.cohesive_dissipated << ", contact " << l.contact_dissipated << ", external work " << l.external_work << ")";
+     << l.cohesive_dissipated << ", contact " << l.contact_dissipated << " + " << l.contact_work << ", external work "
+     << l.external_work << ")";
   const auto name = [&](size_t i) {
     os << "node " << model.mesh.node_gid[i] << " (body '" << model.scene.bodies[model.mesh.node_body[i]].name
        << "') at (" << x[i].x() << ", " << x[i].y() << ", " << x[i].z() << ") has velocity (" << v[i].x() << ", "

@@ -6,23 +6,22 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
-#include <span>
 
 #include "kernels/exact_sum.hpp"
 #include "kernels/types.hpp"
 
 namespace shatter {
 
-/// K exact sums over the indices `items`: term(i, sums) adds index i's terms
-/// to sums[0..K) (ExactSum, kernels/exact_sum.hpp). The items are split over
-/// the threads in any way; the sums are exact, so the result does not depend
-/// on the split.
+/// K exact sums over i in [0, n): term(i, sums) adds i's terms to
+/// sums[0..K) (ExactSum, kernels/exact_sum.hpp). The range is split over the
+/// threads in any way; the sums are exact, so the result does not depend on
+/// the split.
 template <int K, class Term>
-std::array<ExactSum, K> exact_sums(std::span<const Index> items, Term term) {
+std::array<ExactSum, K> exact_sums(Index n, Term term) {
   tbb::combinable<std::array<ExactSum, K>> partial;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, n, 16), [&](const tbb::blocked_range<Index>& r) {
     std::array<ExactSum, K>& sums = partial.local();
-    for (size_t k = r.begin(); k < r.end(); ++k) term(items[k], sums);
+    for (Index i = r.begin(); i < r.end(); ++i) term(i, sums);
   });
   std::array<ExactSum, K> total;
   partial.combine_each([&](const std::array<ExactSum, K>& p) {

@@ -54,6 +54,16 @@ void check_restart(const std::filesystem::path& checkpoint, const SimulationStat
                        " (a row every " + std::to_string(every) + " steps); expected its rows up to step " +
                        std::to_string(needed) + " (the run's own " + name + ")");
   }
+  // The rows appended must be of the columns above them (an older shatter's history.csv
+  // has no contact_work, for one).
+  std::string header, expected;
+  std::ifstream history(out_dir / "history.csv", std::ios::binary);
+  std::getline(history, header);
+  for (const std::string& column : history_columns()) expected += (expected.empty() ? "" : ",") + column;
+  if (header != expected)
+    throw InputError(where + ": " + (out_dir / "history.csv").string() + " has the columns '" +
+                     header.substr(0, 400) + "'; expected '" + expected +
+                     "' (written by another version of shatter? the rows continued would not match them)");
   const std::filesystem::path fields = out_dir / ("restart_" + std::to_string(state.step));
   for (const char* name : {"fields.h5", "fields.xdmf"}) refuse_non_file_at(fields / name, true);
 }

@@ -18,7 +18,8 @@ namespace shatter {
 ///    not a number (named by line), or ends before the last row the run wrote
 ///    at or before the checkpoint's step (a row every `run.history_every`
 ///    steps, the scene's when the checkpoint does not record it): the rows in
-///    between are lost and the continued file would have a gap;
+///    between are lost and the continued file would have a gap; or when
+///    history.csv's header is not history_columns() (an older shatter's);
 ///  - `out_dir`/restart_<step>/fields.h5 or fields.xdmf is a folder or a device.
 void check_restart(const std::filesystem::path& checkpoint, const SimulationState& state,
                    const CheckpointRun& run, const Scene& scene, const std::filesystem::path& out_dir);

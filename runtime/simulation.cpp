@@ -21,9 +21,7 @@ namespace shatter {
 
 template <int K, class Term>
 std::array<ExactSum, K> Simulation::granule_sums(Term term) const {
-  std::vector<Index> slots(dec_->owned_granules().size());
-  for (size_t k = 0; k < slots.size(); ++k) slots[k] = static_cast<Index>(k);
-  return exact_sums<K>(slots, [&](Index k, std::array<ExactSum, K>& sums) {
+  return exact_sums<K>(static_cast<Index>(dec_->owned_granules().size()), [&](Index k, std::array<ExactSum, K>& sums) {
     std::array<double, K> partial{};
     for (Index i : dec_->home_nodes(k)) term(i, partial);
     for (int c = 0; c < K; ++c) sums[c] += partial[c];
@@ -55,8 +53,6 @@ Simulation::Simulation(Model& model, RunOptions options)
   f_ext_.assign(n, Vec3::Zero());
   if (model_.scene.contact) {
     contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
-    book_contact_work_ =
-        model_.scene.contact->restitution < 1.0 || model_.scene.contact->friction > 0.0;
   }
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
@@ -163,7 +159,7 @@ void Simulation::step() {
   timed(comm_seconds_, [&] { dec_->begin_ghost_update(x_); });
   book_gravity_work();
   compute_forces(step_ + 1, time_ + dt_, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
-  if (book_contact_work_) book_contact_work();
+  if (contact_) book_contact_work();
   correct(reaction_old);
   time_ += dt_;
   ++step_;
@@ -197,17 +193,14 @@ void Simulation::resolve_contact() {
     timed(comm_seconds_, [&] { dec_->share(*surface_nodes_, arrays); });
   }
   const std::vector<Index>& vertices = contact_->surface().vertices;
-  if (book_contact_work_) {
-    contact_dx_.resize(vertices.size());
-    contact_dv_.resize(vertices.size());
-    for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
-  }
+  contact_dx_.resize(vertices.size());
+  contact_dv_.resize(vertices.size());
+  for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
   const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt_);
-  if (book_contact_work_)
-    for (size_t k = 0; k < vertices.size(); ++k) {
-      contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
-      contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
-    }
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
+    contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
+  }
   ledger_.contacts = r.contacts;
   ledger_.contact_dissipated += r.dissipated;
   if (r.capped) {
@@ -234,7 +227,7 @@ void Simulation::book_gravity_work() {
 void Simulation::book_contact_work() {
   // What the contact's changes dx of x(n+1) and dv of v(n+1/2) did to the central-difference
   // energy besides the impulses' kinetic-energy loss, to first order: -f(n+1) . (dx - dt/2 dv)
-  // (docs/contact.md, "The ledger with e < 1"); booked as contact dissipation.
+  // (docs/contact.md, "The ledger with e < 1"); booked as contact_work, whatever the law.
   const double half = 0.5 * dt_;
   const std::vector<Index>& vertices = contact_->surface().vertices;
   for (size_t k = 0; k < vertices.size(); ++k) {
@@ -352,7 +345,7 @@ void Simulation::update_ledger() {
   ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());
   ledger_.strain = t[kStrain].value();
   ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value();
-  ledger_.contact_dissipated += t[kLocal + kContactWork].value();
+  ledger_.contact_work += t[kLocal + kContactWork].value();
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
                                               std::abs(ledger_.external_work));

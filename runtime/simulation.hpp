@@ -55,7 +55,7 @@ struct RunOptions {
   /// Called on every rank before each step with the number of the step to
   /// come (null: nothing); what it throws fails the step as the step would
   /// (tests inject failures with it: tests/mpi/fail_alone.cpp).
-  std::function<void(long)> before_step;
+  std::function<void(long)> before_step = nullptr;
 };
 
 /// The complete state of a run between two steps: what a checkpoint holds
@@ -133,7 +133,7 @@ class Simulation {
   void resolve_contact();
   /// Gravity's work over the step, on the owned nodes.
   void book_gravity_work();
-  /// The contact's first-order work, on the owned contact vertices (book_contact_work_).
+  /// The contact's first-order work (Ledger::contact_work), on the owned contact vertices.
   void book_contact_work();
   /// v(n+1) = v(n+1/2) + dt/2 a(n+1); the reactions' work over the step.
   void correct(const std::vector<Vec3>& reaction_old);
@@ -173,8 +173,8 @@ class Simulation {
   double next_dt();
 
   /// The step's work terms, exact sums over this rank's owned nodes, summed
-  /// over the ranks by update_ledger: gravity's work, the reactions' work and,
-  /// with book_contact_work_, the contact's f(n+1) . (dx - dt/2 dv).
+  /// over the ranks by update_ledger: gravity's work, the reactions' work and
+  /// the contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work).
   enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
 
   Model& model_;
@@ -203,10 +203,6 @@ class Simulation {
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
   std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
-  /// With a dissipative contact law (e < 1 or mu > 0) the first-order energy change of the
-  /// contact's moves is booked in contact_dissipated with the impulses' kinetic-energy loss
-  /// (docs/contact.md "The ledger with e < 1"); for e = 1, mu = 0 it is left visible.
-  bool book_contact_work_ = false;
   std::vector<Vec3> contact_dx_,
       contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block

@@ -33,7 +33,7 @@ void Simulation::write_outputs(bool fields) {
   const Ledger& l = ledger_;
   if (root) {
     *history_ << step_ << time_ << dt_ << l.kinetic << l.strain << l.cohesive_stored << l.cohesive_dissipated
-              << l.contact_dissipated << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
+              << l.contact_dissipated << l.contact_work << l.external_work << l.total() << l.momentum.x() << l.momentum.y()
               << l.momentum.z() << l.angular_momentum.x() << l.angular_momentum.y() << l.angular_momentum.z()
               << l.contacts << l.cohesive_elements << l.fragments << l.contact_capped_steps;
     history_->end_row();
@@ -207,6 +207,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("cohesive_stored", l.cohesive_stored);
   j.add("cohesive_dissipated", l.cohesive_dissipated);
   j.add("contact_dissipated", l.contact_dissipated);
+  j.add("contact_work", l.contact_work);
   j.add("external_work", l.external_work);
   j.add("total", l.total());
   j.add("initial_total", total0_);

@@ -33,12 +33,7 @@ long Simulation::run() {
     if (restored_ && root)
       for (const char* csv : {"history.csv", "bodies.csv"}) truncate_rows_after(opt_.out_dir / csv, step_);
     if (root) {
-    history_ = std::make_unique<CsvWriter>(
-        opt_.out_dir / "history.csv",
-        std::vector<std::string>{"step", "time", "dt", "kinetic", "strain", "cohesive_stored", "cohesive_dissipated",
-                                 "contact_dissipated", "external_work", "total", "px", "py", "pz", "Lx", "Ly", "Lz",
-                                 "contacts", "cohesive_elements", "fragments", "contact_capped_steps"},
-        restored_);
+    history_ = std::make_unique<CsvWriter>(opt_.out_dir / "history.csv", history_columns(), restored_);
     bodies_ = std::make_unique<CsvWriter>(
         opt_.out_dir / "bodies.csv",
         std::vector<std::string>{"step", "time", "body", "mass", "cx", "cy", "cz", "vx", "vy", "vz"}, restored_);

@@ -6,7 +6,8 @@ Usage: plot.py OUTDIR          (or `shatter plot OUTDIR`)
 Reads OUTDIR/history.csv (required), OUTDIR/bodies.csv and OUTDIR/fragments.csv
 (when present) and writes PNGs into OUTDIR/plots/:
 
-  energies.png   every ledger term of history.csv and the total vs time
+  energies.png   every ledger term of history.csv that is not 0 throughout
+                 (contact_work too, when the file has it) and the total vs time
   momenta.png    linear momentum (px, py, pz) and angular momentum (Lx, Ly, Lz)
                  about the origin vs time
   contacts.png   active contacts vs time
@@ -22,8 +23,11 @@ import os
 import sys
 
 # Columns of history.csv that are terms of the energy ledger, in the order of
-# SCENE.md; `total` is drawn on top of them.
-ENERGY_TERMS = ["kinetic", "strain", "cohesive_stored", "cohesive_dissipated", "contact_dissipated", "external_work"]
+# SCENE.md; `total` is drawn on top of them. contact_work is drawn when present:
+# the history.csv of a shatter before it (issue 18) has no such column.
+ENERGY_TERMS = ["kinetic", "strain", "cohesive_stored", "cohesive_dissipated", "contact_dissipated", "contact_work",
+                "external_work"]
+OPTIONAL_TERMS = ("contact_work",)
 MOMENTA = ["px", "py", "pz", "Lx", "Ly", "Lz"]
 
 
@@ -180,7 +184,8 @@ def main(argv):
     if not os.path.isfile(history):
         fail(f"{history}: no such file (is {out_dir} the output folder of a run?)")
     h = read_columns(history)
-    require(h, ["time", "total", "contacts", "fragments"] + ENERGY_TERMS + MOMENTA, history)
+    required = [t for t in ENERGY_TERMS if t not in OPTIONAL_TERMS]
+    require(h, ["time", "total", "contacts", "fragments"] + required + MOMENTA, history)
     if not h["time"]:
         fail(f"{history}: no rows")
 

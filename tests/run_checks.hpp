@@ -1,9 +1,12 @@
 #pragma once
-// Checks on a running Simulation shared by the whole-run tests: body motion
-// and the independent penetration check (point in tetrahedron on the volume
-// meshes, brute force, no DCR code involved).
+// Checks on a running Simulation shared by the whole-run tests: body motion,
+// the independent penetration check (point in tetrahedron on the volume
+// meshes, brute force, no DCR code involved) and the ledger's history.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <span>
+#include <vector>
 
 #include "runtime/contact_stage.hpp"
 #include "runtime/simulation.hpp"
@@ -63,6 +66,16 @@ inline int count_penetrations(const Simulation& sim, double depth = 1e-6) {
     }
   }
   return found;
+}
+
+/// Succeeds when no value is below the one before it (a ledger column over the steps of a
+/// run, e.g. contact_dissipated, SCENE.md); else names the first entry that is, and by how much.
+inline ::testing::AssertionResult never_decreases(std::span<const double> values) {
+  for (size_t k = 1; k < values.size(); ++k)
+    if (values[k] < values[k - 1])
+      return ::testing::AssertionFailure() << "entry " << k << " is " << values[k] << ", "
+                                           << values[k - 1] - values[k] << " below the one before";
+  return ::testing::AssertionSuccess();
 }
 
 }  // namespace shatter::test

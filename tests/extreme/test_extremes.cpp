@@ -28,6 +28,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "expect_close.hpp"
@@ -69,6 +70,7 @@ struct Watch {
   long steps = 0;
   int penetrations = 0;
   bool finite = true;
+  std::vector<double> contact_dissipated;  ///< after every step, J
 };
 
 /// Steps `sim` to `end` (s), checking after every step: positions finite, momentum,
@@ -86,6 +88,7 @@ Watch run_watched(Simulation& sim, double end, const std::function<void()>& afte
     w.finite = w.finite && std::isfinite(sim.ledger().total());
     w.max_energy_error = std::max(w.max_energy_error, std::abs(sim.energy_error()));
     w.max_dp = std::max(w.max_dp, (sim.ledger().momentum - w.first.momentum).norm() / w.p_scale);
+    w.contact_dissipated.push_back(sim.ledger().contact_dissipated);
     if (sim.contact()) {
       w.contact_steps += sim.ledger().contacts > 0;
       w.penetrations += count_penetrations(sim);
@@ -97,10 +100,12 @@ Watch run_watched(Simulation& sim, double end, const std::function<void()>& afte
 }
 
 /// The common verdict of a run that must complete: finite, no penetration, momentum
-/// to round-off (no gravity, no boundary conditions), energy error below `energy_tol`.
+/// to round-off (no gravity, no boundary conditions), energy error below `energy_tol`,
+/// contact_dissipated never decreasing.
 void expect_clean(const Watch& w, double energy_tol, bool momentum_kept = true) {
   EXPECT_TRUE(w.finite) << "NaN or Inf after step " << w.steps;
   EXPECT_EQ(w.penetrations, 0);
+  EXPECT_TRUE(test::never_decreases(w.contact_dissipated)) << "contact_dissipated";
   if (momentum_kept) {
     EXPECT_LT(w.max_dp, 1e-12);
   }
@@ -617,12 +622,19 @@ TEST(Extreme, InelasticImpactBooksItsKineticEnergyLoss) {
 // A sliver (four nearly coplanar vertices, height 1/100 of the width: its smallest
 // altitude sets a step 25 x shorter than the block's) and a needle (base 1/100 of its
 // length, tip down) fall onto a block and bounce off, ringing; fixed step (see start()).
+// The energy bound is 5 % for the needle (4.5e-6 measured) and 7.5 % for the sliver:
+// since issue 18 the ledger books the contact's first-order work for e = 1 too, and for
+// the sliver, which rings near the stability limit (K dt^2 / m ~ 1), the second-order
+// terms that estimate leaves are as large as it: contact_work ends at -7.7e-7 J (5.8 % of
+// the energy fed in, by the estimate) where kinetic + strain rose by about 3 %; the error,
+// max 3.8 % without the term, is max 6.9 %, final -2.2 % with it (docs/extremes.md).
 TEST(Extreme, SliverAndNeedleHitABlock) {
-  for (const auto& [name, v] : {std::pair{"sliver", kSliver}, std::pair{"needle", kNeedle}}) {
+  for (const auto& [name, v, energy_tol] :
+       {std::tuple{"sliver", kSliver, 0.075}, std::tuple{"needle", kNeedle, 0.05}}) {
     SCOPED_TRACE(name);
     const Started r = run_bad_tet_on_block(name, v, true);
     ASSERT_GT(r.w.contact_steps, 0);
-    expect_clean(r.w, 0.05);
+    expect_clean(r.w, energy_tol);
     EXPECT_GT(body_velocity(*r.sim, 1).z() - body_velocity(*r.sim, 0).z(), 0.0)
         << "the tet did not bounce";
   }
@@ -636,8 +648,9 @@ TEST(Extreme, SliverAndNeedleHitABlock) {
 // to 1e-3 (measured: equal to 1e-6; the step that followed the state: 0.1). What is
 // left is central difference's bounded oscillation, O((omega dt)^2) of the energy of a
 // sliver ringing near the stability limit (measured -1.5 ... +11.4 %, mean 4.9 %, set by
-// the impact), so the bound on the error itself is 15 %, not the fixed-step case's 5 %
-// at half this step.
+// the impact; with the contact's first-order work booked for e = 1, issue 18: largest
+// 13.0 %, mean -6.6 %, the estimate's second-order remainder, see the fixed-step test),
+// so the bound on the error itself is 15 %, not the fixed-step case's at half this step.
 TEST(Extreme, AdaptiveStepSliverHitsABlock) {
   std::vector<double> err;
   const Started r = run_bad_tet_on_block("sliver", kSliver, false, &err);

@@ -101,6 +101,7 @@ void expect_same_ledger(const Ledger& a, const Ledger& b) {
   EXPECT_EQ(a.cohesive_stored, b.cohesive_stored);
   EXPECT_EQ(a.cohesive_dissipated, b.cohesive_dissipated);
   EXPECT_EQ(a.contact_dissipated, b.contact_dissipated);
+  EXPECT_EQ(a.contact_work, b.contact_work);
   EXPECT_EQ(a.external_work, b.external_work);
   EXPECT_TRUE(a.momentum == b.momentum);
   EXPECT_TRUE(a.angular_momentum == b.angular_momentum);

@@ -160,7 +160,8 @@ TEST(CheckpointCorruption, BinaryRefusesWithOneLine) {
 }
 
 // A checkpoint of format version 2 (before the physics keys and the
-// whole-file hash) is still read, without those checks.
+// whole-file hash, and the ledger's contact_work of version 4) is still read,
+// without those checks.
 TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
   Checkpoints& c = checkpoints();
   const fs::path file = c.dir / "version2.h5";
@@ -174,6 +175,9 @@ TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
     H5Aclose(version);
     for (const char* name : {"physics", "scene_fingerprint", "history_every", "state_fnv1a64"})
       EXPECT_GE(H5Adelete(root, name), 0) << name;
+    const hid_t ledger = H5Gopen2(root, "ledger", H5P_DEFAULT);
+    EXPECT_GE(H5Adelete(ledger, "contact_work"), 0) << "contact_work (version 4)";
+    H5Gclose(ledger);
     H5Gclose(root);
     H5Fclose(f);
   }
@@ -182,7 +186,9 @@ TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
   const Model model = build_model(test::scene_from_text("corrupt_v2_" + std::to_string(getpid()), softer));
   CheckpointRun run;
   run.history_every = -1;
-  EXPECT_EQ(read_checkpoint(file, model, &run).step, 3);
+  const SimulationState s = read_checkpoint(file, model, &run);
+  EXPECT_EQ(s.step, 3);
+  EXPECT_EQ(s.ledger.contact_work, 0.0) << "before version 4: not recorded, continues from 0";
   EXPECT_EQ(run.history_every, 0) << "not recorded in version 2";
   // Version 3 refuses the same scene.
   std::ofstream(file, std::ios::binary | std::ios::trunc) << c.a;

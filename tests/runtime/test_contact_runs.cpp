@@ -31,6 +31,7 @@ using namespace shatter;
 using shatter::test::body_centre;
 using shatter::test::body_velocity;
 using shatter::test::count_penetrations;
+using shatter::test::never_decreases;
 using shatter::test::scene_from_text;
 
 namespace {
@@ -43,16 +44,18 @@ const char* kSteel = "  steel: {model: neo_hookean, density: 7850, youngs_modulu
 // exactly one-dimensional, the bar speed sqrt(E / rho) is the dilatational speed), bar 0
 // at v, bar 1 at rest. Elastic impact of equal bars: the contact lasts 2 L / c, then bar 0
 // is at rest and bar 1 moves at v. Small v keeps the strain (v / 2c = 1e-4) linear.
-// For both collision placements (contact.placement): the issue's 1 % on the total energy
-// holds for `middle` (+0.02 % measured); `end` ([CW]'s placement) loses 1.29 %
-// (docs/contact.md), held to 2 % so that it cannot get worse unnoticed.
+// For both collision placements (contact.placement): the issue's 1 % on the ledger total,
+// which books the first-order work of the contact's moves in contact_work (e = 1 too):
+// measured -0.008 % for `middle`, +0.075 % for `end` ([CW]'s placement, whose 1.29 % loss
+// of kinetic + strain energy is the contact_work, +1.46 % of the total, docs/contact.md).
+// contact_dissipated stays 0 (elastic impulses) and never decreases.
 TEST(ContactRuns, EqualBarsHeadOnLast2LOverCAndExchangeVelocities) {
   const double len = 0.05, w = 0.005, v = 1.0, gap = 2e-6;
   const double E = 210.0e9, rho = 7850;
   const std::string x0 = std::to_string(-0.5 * len - 0.5 * gap), x1 = std::to_string(0.5 * len + 0.5 * gap);
   const std::string bar = "shape: box, size: [" + std::to_string(len) + ", " + std::to_string(w) + ", " +
                           std::to_string(w) + "], element_size: 0.0025, order: 1";
-  for (const auto& [placement, energy_bound] : {std::pair{"middle", 0.01}, std::pair{"end", 0.02}}) {
+  for (const auto& [placement, energy_bound] : {std::pair{"middle", 0.01}, std::pair{"end", 0.01}}) {
     SCOPED_TRACE(placement);
     Model m = build_model(scene_from_text(
         "bars", "name: bars\ntime: {end: 1.0}\nmaterials:\n"
@@ -66,8 +69,10 @@ TEST(ContactRuns, EqualBarsHeadOnLast2LOverCAndExchangeVelocities) {
     const Ledger l0 = sim.ledger();
     double t_first = -1, t_last = -1, dp_max = 0;
     int penetrations = 0;
+    std::vector<double> dissipated;
     while (sim.time() < gap / v + 1.6 * duration) {
       sim.step();
+      dissipated.push_back(sim.ledger().contact_dissipated);
       if (sim.ledger().contacts > 0) {
         if (t_first < 0) t_first = sim.time();
         t_last = sim.time();
@@ -79,10 +84,12 @@ TEST(ContactRuns, EqualBarsHeadOnLast2LOverCAndExchangeVelocities) {
     EXPECT_CLOSE(t_last - t_first, duration, 0.05, 0) << "contact from " << t_first << " to " << t_last << " s";
     EXPECT_NEAR(body_velocity(sim, 0).x(), 0.0, 0.05 * v);
     EXPECT_CLOSE(body_velocity(sim, 1).x(), v, 0.05, 0);
-    std::printf("bars (%s): contact %.4e s (2L/c %.4e), v_a %.4f v_b %.4f of v, energy %+.3e\n", placement,
-                t_last - t_first, duration, body_velocity(sim, 0).x() / v, body_velocity(sim, 1).x() / v,
-                sim.ledger().total() / l0.total() - 1);
+    std::printf("bars (%s): contact %.4e s (2L/c %.4e), v_a %.4f v_b %.4f of v, energy %+.3e, contact_work %+.3e "
+                "of the total\n", placement, t_last - t_first, duration, body_velocity(sim, 0).x() / v,
+                body_velocity(sim, 1).x() / v, sim.ledger().total() / l0.total() - 1,
+                sim.ledger().contact_work / l0.total());
     EXPECT_EQ(sim.ledger().contact_dissipated, 0.0);
+    EXPECT_TRUE(never_decreases(dissipated));
     EXPECT_CLOSE(sim.ledger().total(), l0.total(), energy_bound, 0);
     EXPECT_LT(dp_max, 1e-12 * l0.momentum.norm());
     EXPECT_EQ(penetrations, 0);
@@ -139,10 +146,11 @@ TEST(ContactRuns, BlockSlidingOnPlateDeceleratesAtMuGAndStops) {
   Model m = block_on_plate("slide", mu, Vec3(0, 0, -g), v0);
   Simulation sim(m, {});
   const double t_stop = v0 / (mu * g);
-  std::vector<double> ts, vs;
+  std::vector<double> ts, vs, dissipated;
   int penetrations = 0;
   while (sim.time() < 1.3 * t_stop) {
     sim.step();
+    dissipated.push_back(sim.ledger().contact_dissipated);
     const double t = sim.time();
     if (t > 0.15 * t_stop && t < 0.85 * t_stop) {
       ts.push_back(t);
@@ -161,6 +169,7 @@ TEST(ContactRuns, BlockSlidingOnPlateDeceleratesAtMuGAndStops) {
   // Stays: less than 1 % of the slide distance v0^2 / (2 mu g) in 500 more steps.
   EXPECT_LT((body_centre(sim, 1) - c_stop).norm(), 0.01 * v0 * v0 / (2 * mu * g));
   EXPECT_EQ(penetrations, 0);
+  EXPECT_TRUE(never_decreases(dissipated));
 }
 
 // The plate tilted by theta (gravity turned instead): with tan(theta) < mu the block put
@@ -200,9 +209,10 @@ TEST(ContactRuns, BlockOnInclineSticksBelowFrictionAngleAndSlidesAbove) {
 
 // e < 1 in resting contact (docs/contact.md "The ledger with e < 1"): the block put down on
 // the plate (1e-6 m above it) under gravity, e = 0, mu = 0.3, rests; the impulses that stop
-// its bottom nodes every step lose kinetic energy that the projection fed in, and the ledger
-// books that loss together with the first-order work of the contact's moves,
-// f(n+1) . (dx - dt/2 dv), so its total stays flat: within 1e-4 m g h over 10 ms for `end`
+// its bottom nodes every step lose kinetic energy that the projection fed in: the ledger
+// books that loss in contact_dissipated (5.5e-7 J, `end`) and the first-order work of the
+// contact's moves, f(n+1) . (dx - dt/2 dv), in contact_work (-4.9e-7 J: energy fed in), so
+// its total stays flat: within 1e-4 m g h over 10 ms for `end`
 // (measured 2.9e-5 m g h in 20 ms: it drifts by the end placement's second-order error),
 // 1e-6 m g h for `middle` (4.5e-8). Booking the impulses' loss alone gained 3.5e-4 m g h
 // per 10 ms (5.5e-7 J, docs/contact.md).
@@ -215,13 +225,17 @@ TEST(ContactRuns, RestingBlockKeepsTheLedgerFlat) {
     const double mgh = m.body_mass[1] * g * h, total0 = sim.ledger().total();
     double drift = 0;
     int penetrations = 0;
+    std::vector<double> dissipated;
     while (sim.time() < 0.01) {
       sim.step();
+      dissipated.push_back(sim.ledger().contact_dissipated);
       drift = std::max(drift, std::abs(sim.ledger().total() - total0));
       penetrations += count_penetrations(sim);
     }
-    std::printf("resting block (%s): ledger total moved %.3e J = %.3e m g h; contact_dissipated %.3e J\n", placement,
-                drift, drift / mgh, sim.ledger().contact_dissipated);
+    std::printf("resting block (%s): ledger total moved %.3e J = %.3e m g h; contact_dissipated %.3e J, "
+                "contact_work %+.3e J\n", placement, drift, drift / mgh, sim.ledger().contact_dissipated,
+                sim.ledger().contact_work);
+    EXPECT_TRUE(never_decreases(dissipated));
     EXPECT_LT(drift, bound * mgh);
     EXPECT_LT(std::abs(body_velocity(sim, 1).z()), 1e-3) << "the block does not rest";
     EXPECT_EQ(penetrations, 0);
@@ -253,6 +267,8 @@ std::string oblique_scene(const std::string& law = "{friction: 0.3, restitution:
 // sum m |x| |v| here; the bound is 1e-4 (the 1e-10 goal needs a projection that keeps it,
 // docs/contact.md). With placement: middle only the projections of pairs the impulse
 // leaves unseparated remain: 2.3e-6 (e = 1) and 6.7e-6 (e = 0.5, mu = 0.3).
+// The ledger total (contact_work included) stays within 1 % of itself (at most 0.30 %
+// measured, e = 1 with `end`), and contact_dissipated never decreases.
 TEST(ContactRuns, ObliqueFrictionalImpactConservesMomenta) {
   struct Case {
     const char* law;
@@ -270,16 +286,23 @@ TEST(ContactRuns, ObliqueFrictionalImpactConservesMomenta) {
     for (Index i = 0; i < m.mesh.num_nodes(); ++i)
       L_scale += m.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
     long contact_steps = 0;
-    double dp = 0, dL = 0;
+    double dp = 0, dL = 0, dE = 0;
     int penetrations = 0;
+    std::vector<double> dissipated;
     for (int s = 0; s < 400; ++s) {
       sim.step();
+      dissipated.push_back(sim.ledger().contact_dissipated);
+      dE = std::max(dE, std::abs(sim.ledger().total() - l0.total()));
       contact_steps += sim.ledger().contacts > 0;
       dp = std::max(dp, (sim.ledger().momentum - l0.momentum).norm());
       dL = std::max(dL, (sim.ledger().angular_momentum - l0.angular_momentum).norm());
       penetrations += count_penetrations(sim);
     }
-    std::printf("%s: dp %g, dL %g of sum m |x| |v|\n", c.law, dp / l0.momentum.norm(), dL / L_scale);
+    std::printf("%s: dp %g, dL %g of sum m |x| |v|; contact_dissipated %.3e, contact_work %+.3e, ledger total "
+                "moved %.3e, of the total\n", c.law, dp / l0.momentum.norm(), dL / L_scale,
+                sim.ledger().contact_dissipated / l0.total(), sim.ledger().contact_work / l0.total(), dE / l0.total());
+    EXPECT_TRUE(never_decreases(dissipated));
+    EXPECT_LT(dE, 0.01 * l0.total());
     ASSERT_GT(contact_steps, 10);
     if (c.dissipates) {
       EXPECT_GT(sim.ledger().contact_dissipated, 0.0);

@@ -53,10 +53,11 @@ RunResult run_ring(int threads, int steps) {
   for (int s = 0; s < steps; ++s) {
     sim.step();
     // The cached labels (renewed only when facets are freed) are a fresh labelling.
-    if (s % 100 == 99)
+    if (s % 100 == 99) {
       EXPECT_EQ(sim.fracture()->fragment_labels().elem_fragment,
                 label_fragments(m.mesh, sim.fracture()->topology()).elem_fragment)
           << "step " << s + 1;
+    }
   }
   r.x.assign(sim.positions().begin(), sim.positions().end());
   r.ledger = sim.ledger();

@@ -96,6 +96,22 @@ TEST(RestartRefusal, RowsEndingBeforeTheCheckpointAreRefused) {
   r.expect_untouched();
 }
 
+// A history.csv of an older shatter (no contact_work column): the rows appended would be
+// one value wider than its header.
+TEST(RestartRefusal, HistoryOfOtherColumnsIsRefused) {
+  FinishedRun r = finished_run("restart_old_columns");
+  std::string old = r.files["history.csv"];
+  const size_t header_end = old.find('\n');
+  std::string header = old.substr(0, header_end);
+  header.replace(header.find(",contact_work"), 13, "");
+  old.replace(0, header_end, header);
+  std::ofstream(r.dir / "history.csv", std::ios::binary | std::ios::trunc) << old;
+  r.keep();
+  expect_refused(r.restart("--set time.end=2.0e-6"), (r.dir / "history.csv").string() + " has the columns '" +
+                                                         header + "'; expected '");
+  r.expect_untouched();
+}
+
 TEST(RestartRefusal, ChangedPhysicsIsRefusedNamingTheKey) {
   FinishedRun r = finished_run("restart_physics");
   expect_refused(r.restart("--set time.end=2.0e-6 --set materials.steel.youngs_modulus=100.0e9"),
