@@ -157,8 +157,11 @@ TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
 
 TEST(Decomposition, BuildModelOnSeveralRanksMeshesOnceForAll) {
   // Rank 0 meshes, every rank gets its mesh: the same model as one built alone.
+  // (Each rank writes its own scene file: one file written by all would race.)
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   const Scene scene = test::scene_from_text(
-      "build_model_world",
+      "build_model_world_rank" + std::to_string(rank),
       "name: world\n"
       "time: {end: 1.0}\n"
       "materials:\n"
@@ -171,8 +174,6 @@ TEST(Decomposition, BuildModelOnSeveralRanksMeshesOnceForAll) {
   std::uint64_t fp[2] = {model_fingerprint(world), ~model_fingerprint(world)};
   MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
   EXPECT_EQ(fp[0], ~fp[1]) << "the ranks' models differ";
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (rank == 0) {
     EXPECT_EQ(model_fingerprint(build_model(scene)), model_fingerprint(world));
   }
