@@ -4,9 +4,12 @@
 #include <gmsh.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "expect_close.hpp"
 #include "kernels/error.hpp"
@@ -167,6 +170,35 @@ TEST(MeshFile, OtherFilesAreRefusedAndGmshRecovers) {
     EXPECT_NE(crashed.find("); expected a well-formed file of that format"), std::string::npos) << crashed;
     EXPECT_GT(read_mesh_file((dir / "ideas.unv").string(), "", 0, 0, "w").num_elements(), 300);
   }
+  // Hostile node tags in a .msh 4.1 (issue 21): an element naming node 3e9
+  // (>= 2^31) or -5, and a duplicate node tag, once crashed shatter inside
+  // Gmsh or were read; and the binary file fuzz_msh found. Gmsh reads a .msh
+  // in the child process too: each is refused, and the next file reads.
+  std::ifstream seed_in(fs::path(SHATTER_SOURCE_DIR) / "tests/fuzz/seeds/msh/box_tet4_v41.msh");
+  std::vector<std::string> seed;
+  for (std::string line; std::getline(seed_in, line);) seed.push_back(line);
+  const size_t first_element = std::find(seed.begin(), seed.end(), "$Elements") - seed.begin() + 3;
+  const size_t tag_two = std::find(seed.begin(), seed.end(), "0 2 0 1") - seed.begin() + 1;
+  ASSERT_LT(tag_two, first_element);
+  ASSERT_EQ(seed[first_element].rfind("1 29 37 21 45", 0), 0u);
+  for (const auto& [name, line, text] : {std::tuple{"tag_big.msh", first_element, "1 3000000000 37 21 45"},
+                                         std::tuple{"tag_negative.msh", first_element, "1 -5 37 21 45"},
+                                         std::tuple{"tag_twice.msh", tag_two, "1"}}) {
+    std::vector<std::string> lines = seed;
+    lines[line] = text;
+    const std::string file = (dir / name).string();
+    std::ofstream out(file);
+    for (const std::string& l : lines) out << l << "\n";
+    out.close();
+    const std::string why = input_error([&] { read_mesh_file(file, "", 0, 0, "w"); });
+    EXPECT_EQ(why.rfind("w: Gmsh c", 0), 0u) << name << ": " << why;  // "cannot read" or "crashed reading"
+    EXPECT_NE(why.find(file), std::string::npos) << why;
+  }
+  const std::string fuzzed =
+      (fs::path(SHATTER_SOURCE_DIR) / "tests/fuzz/crashes/msh/binary_v41_node_tag_segfault.msh").string();
+  const std::string fuzzed_why = input_error([&] { read_mesh_file(fuzzed, "", 0, 0, "w"); });
+  EXPECT_EQ(fuzzed_why.rfind("w: Gmsh crashed reading '" + fuzzed + "' as a .msh file (", 0), 0u) << fuzzed_why;
+  EXPECT_GT(read_mesh_file((dir / "v41_ascii.msh").string(), "", 0, 0, "w").num_elements(), 300);
   // A surface mesh in a format that also holds volumes.
   const std::string surface = (dir / "surface.vtk").string();
   std::ofstream(surface) << "# vtk DataFile Version 2.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n"
