@@ -1,7 +1,6 @@
 // Simulation: the run's outputs (SCENE.md "Outputs"): history.csv and
 // bodies.csv rows, field frames, fragments.csv and summary.json.
 #include <algorithm>
-#include <optional>
 
 #include "runtime/contact_stage.hpp"
 #include "runtime/decomposition.hpp"
@@ -15,14 +14,6 @@
 #include "runtime/timed.hpp"
 
 namespace shatter {
-namespace {
-
-struct BodyRow {
-  double mass = 0;
-  Vec3 mx = Vec3::Zero(), mv = Vec3::Zero();
-};
-
-}  // namespace
 
 void Simulation::write_outputs(bool fields) {
   if (opt_.out_dir.empty()) return;
@@ -50,17 +41,13 @@ void Simulation::write_outputs(bool fields) {
     for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
   }
   timed(comm_seconds_, [&] { dec_->sum(sums); });
-  std::vector<BodyRow> rows(nb);
-  for (int b = 0; b < nb; ++b) {
-    const ExactSum* r = sums.data() + static_cast<size_t>(b) * 7;
-    rows[b].mass = r[0].value();
-    rows[b].mx = Vec3(r[1].value(), r[2].value(), r[3].value());
-    rows[b].mv = Vec3(r[4].value(), r[5].value(), r[6].value());
-  }
   for (int b = 0; b < nb && root; ++b) {
-    const Vec3 c = rows[b].mx / rows[b].mass, v = rows[b].mv / rows[b].mass;
-    *bodies_ << step_ << time_ << model_.scene.bodies[b].name << rows[b].mass << c.x() << c.y() << c.z() << v.x()
-             << v.y() << v.z();
+    const ExactSum* r = sums.data() + static_cast<size_t>(b) * 7;
+    const double mass = r[0].value();
+    const Vec3 c = Vec3(r[1].value(), r[2].value(), r[3].value()) / mass,
+               v = Vec3(r[4].value(), r[5].value(), r[6].value()) / mass;
+    *bodies_ << step_ << time_ << model_.scene.bodies[b].name << mass << c.x() << c.y() << c.z() << v.x() << v.y()
+             << v.z();
     bodies_->end_row();
   }
 
