@@ -1,5 +1,6 @@
 #include "mesh/coloring.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 
@@ -14,7 +15,6 @@ Coloring greedy_coloring(std::span<const Index> item_offsets, std::span<const In
   size_t words = 1;
   std::vector<std::uint64_t> used(static_cast<size_t>(num_nodes) * words, 0);
   std::vector<std::uint64_t> forbidden;
-  int n_colors = 0;
   for (Index i = 0; i < n_items; ++i) {
     forbidden.assign(words, 0);
     for (Index k = item_offsets[i]; k < item_offsets[i + 1]; ++k)
@@ -32,10 +32,18 @@ Coloring greedy_coloring(std::span<const Index> item_offsets, std::span<const In
       words = new_words;
     }
     out.color[i] = c;
-    n_colors = std::max(n_colors, c + 1);
     for (Index k = item_offsets[i]; k < item_offsets[i + 1]; ++k)
       used[item_nodes[k] * words + c / 64] |= std::uint64_t{1} << (c % 64);
   }
+  return coloring_from(std::move(out.color));
+}
+
+Coloring coloring_from(std::vector<int> color) {
+  Coloring out;
+  out.color = std::move(color);
+  const Index n_items = static_cast<Index>(out.color.size());
+  int n_colors = 0;
+  for (int c : out.color) n_colors = std::max(n_colors, c + 1);
   out.offsets.assign(n_colors + 1, 0);
   for (Index i = 0; i < n_items; ++i) ++out.offsets[out.color[i] + 1];
   for (int c = 0; c < n_colors; ++c) out.offsets[c + 1] += out.offsets[c];

@@ -28,4 +28,7 @@ struct Coloring {
 Coloring greedy_coloring(std::span<const Index> item_offsets, std::span<const Index> item_nodes,
                          Index num_nodes);
 
+/// The items grouped by the given colors (color[i] >= 0 for item i).
+Coloring coloring_from(std::vector<int> color);
+
 }  // namespace shatter

@@ -273,6 +273,10 @@ std::uint64_t model_fingerprint(const Model& model) {
   return fnv1a(model.bc_velocity.data(), model.bc_velocity.size() * sizeof(Vec3), h);
 }
 
+std::uint64_t whole_fingerprint(const Model& model) {
+  return model.is_part() ? model.part.fingerprint : model_fingerprint(model);
+}
+
 void write_checkpoint(const std::filesystem::path& path, const Model& model,
                       const SimulationState& s, const std::string& failure) {
   const std::filesystem::path tmp = path.string() + ".tmp";
@@ -296,7 +300,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.integer(root, "version", kVersion);
     w.text(root, "scene", model.scene.name);
     w.integer(root, "nodes", s.model_nodes);
-    w.integer(root, "elements", model.mesh.num_elements());
+    w.integer(root, "elements", model.whole_elements());
     w.integer(root, "order", model.mesh.order);
     w.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &s.model_fingerprint);
     w.integer(root, "step", s.step);
@@ -435,18 +439,17 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   }
   const long nodes = r.integer(root, "nodes"), elements = r.integer(root, "elements"),
              order = r.integer(root, "order");
-  if (nodes != model.mesh.num_nodes() || elements != model.mesh.num_elements() ||
-      order != model.mesh.order) {
+  if (nodes != model.whole_nodes() || elements != model.whole_elements() || order != model.mesh.order) {
     std::ostringstream os;
     os << "the checkpoint's model has " << nodes << " nodes and " << elements << " TET"
-       << (order == 2 ? 10 : 4) << " elements, the scene's has " << model.mesh.num_nodes()
-       << " nodes and " << model.mesh.num_elements() << " TET" << model.mesh.nodes_per_element()
+       << (order == 2 ? 10 : 4) << " elements, the scene's has " << model.whole_nodes()
+       << " nodes and " << model.whole_elements() << " TET" << model.mesh.nodes_per_element()
        << " elements (another mesh: element_size, shape or order changed?)";
     r.fail(os.str());
   }
   std::uint64_t fp = 0;
   r.attribute(root, "fingerprint", H5T_NATIVE_UINT64, &fp);
-  r.require(fp == model_fingerprint(model),
+  r.require(fp == whole_fingerprint(model),
             "the model differs from the checkpoint's (mesh coordinates, masses or boundary "
             "conditions changed)");
 
@@ -454,7 +457,7 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   s.model_fingerprint = fp;
   s.model_nodes = nodes;
   // With fracture, the state's node arrays include the split copies.
-  std::size_t n = model.mesh.num_nodes();
+  std::size_t n = model.whole_nodes();
   const bool has_fracture = H5Lexists(root, "fracture", H5P_DEFAULT) > 0;
   r.require(has_fracture == model.scene.fracture_enabled(),
             has_fracture ? "the checkpoint has a fracture state but the scene has no fracture block"
@@ -501,7 +504,8 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);
   r.require(state.valid(), "group /state is missing (truncated or corrupted checkpoint?)");
   std::size_t b = 0;
-  for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
+  if (model.is_part() && !s.fracture) b = model.part.whole_bc_nodes;
+  else for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
   s.x = r.rows(state.get(), "positions", n);
   s.v = r.rows(state.get(), "velocities", n);
   s.a = r.rows(state.get(), "accelerations", n);

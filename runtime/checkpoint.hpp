@@ -73,6 +73,8 @@ namespace shatter {
 /// velocities and their masks. Scene keys that do not change the model
 /// (time.safety, time.end, output, checkpoint) may differ at a restart.
 std::uint64_t model_fingerprint(const Model& model);
+/// model_fingerprint() of the whole model (a part carries it, Model::Part).
+std::uint64_t whole_fingerprint(const Model& model);
 
 /// Writes `state` (from Simulation::save_state) of a run of `model` to `path` atomically: `path`.tmp is
 /// written, flushed and fsync'ed, then renamed over `path` (and the folder

@@ -9,6 +9,7 @@
 #include "mesh/partition.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
+#include "runtime/row_blocks.hpp"
 
 namespace shatter {
 namespace {
@@ -48,25 +49,30 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
     MPI_Comm_size(comm, &size_);
   }
   const Mesh& mesh = model.mesh;
-  const Index ng = (mesh.num_elements() + ElementForces::kGranule - 1) / ElementForces::kGranule;
-  if (size_ > ng)
-    throw InputError(model.scene.file + ": the mesh has " + std::to_string(mesh.num_elements()) + " elements, " +
-                     std::to_string(ng) + " granules of " + std::to_string(ElementForces::kGranule) +
-                     "; it cannot be shared by " + std::to_string(size_) + " MPI ranks (use at most " +
-                     std::to_string(ng) + ")");
-  granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
-  for (Index g = 0; g < ng; ++g) {
-    if (granule_rank_[g] == rank_) {
-      owned_granules_.push_back(g);
-      for (Index e = g * ElementForces::kGranule; e < std::min(mesh.num_elements(), (g + 1) * ElementForces::kGranule); ++e)
-        owned_element_ids_.push_back(e);
-    }
+  if (model.is_part()) {
+    granule_rank_ = model.part.granule_rank;
+  } else {
+    check_ranks(model, size_);
+    granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
   }
+  for (Index g = 0; g < num_granules(); ++g)
+    if (granule_rank_[g] == rank_) owned_granules_.push_back(g);
+  for (Index e = 0; e < mesh.num_elements(); ++e)
+    if (owns_element(e)) owned_element_ids_.push_back(e);
   owned_elements_ = static_cast<Index>(owned_element_ids_.size());
   rebuild_nodes();
 }
 
 Decomposition::~Decomposition() = default;
+
+void check_ranks(const Model& model, int ranks) {
+  const Index ne = model.whole_elements(), ng = (ne + ElementForces::kGranule - 1) / ElementForces::kGranule;
+  if (ranks > ng)
+    throw InputError(model.scene.file + ": the mesh has " + std::to_string(ne) + " elements, " +
+                     std::to_string(ng) + " granules of " + std::to_string(ElementForces::kGranule) +
+                     "; it cannot be shared by " + std::to_string(ranks) + " MPI ranks (use at most " +
+                     std::to_string(ng) + ")");
+}
 
 void Decomposition::rebuild_nodes() {
   const Mesh& mesh = model_.mesh;
@@ -76,7 +82,10 @@ void Decomposition::rebuild_nodes() {
   // Home granule of each node: the granule of the first element of its star;
   // the home nodes of each owned granule, ascending.
   home_granule_.resize(nn);
-  for (Index n = 0; n < nn; ++n) home_granule_[n] = mesh.node_elem[mesh.node_elem_offsets[n]] / ElementForces::kGranule;
+  // (A ghost-only node of a part may not hold its whole star here, but no
+  // element of it is owned here, so neither is the granule computed.)
+  for (Index n = 0; n < nn; ++n)
+    home_granule_[n] = model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
   {
     std::vector<Index> slot(num_granules(), -1);
     for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
@@ -103,11 +112,17 @@ void Decomposition::rebuild_nodes() {
     std::iota(local_elements_.begin(), local_elements_.end(), 0);
     return;
   }
-  std::vector<int> elem_part(ne);
-  for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[e / ElementForces::kGranule];
-  NodeRanks touch = touching_ranks(mesh, elem_part);
-  node_rank_offsets_ = std::move(touch.offsets);
-  node_ranks_ = std::move(touch.ranks);
+  if (model_.is_part()) {
+    // A ghost-only node's star is not whole here: its ranks come from the start-up rank.
+    node_rank_offsets_ = model_.part.node_rank_offsets;
+    node_ranks_ = model_.part.node_ranks;
+  } else {
+    std::vector<int> elem_part(ne);
+    for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[e / ElementForces::kGranule];
+    NodeRanks touch = touching_ranks(mesh, elem_part);
+    node_rank_offsets_ = std::move(touch.offsets);
+    node_ranks_ = std::move(touch.ranks);
+  }
   auto touches = [&](Index n, int r) {
     return std::binary_search(node_ranks_.begin() + node_rank_offsets_[n],
                               node_ranks_.begin() + node_rank_offsets_[n + 1], r);
@@ -155,9 +170,6 @@ void Decomposition::rebuild_nodes() {
       if (!touches(n, q)) send[q].push_back(n);
   }
   halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_);
-  std::vector<Index> all(nn);
-  std::iota(all.begin(), all.end(), 0);
-  all_nodes_ = shared_nodes(std::move(all));
 }
 
 void Decomposition::begin_ghost_update(std::span<const Vec3> x) const {
@@ -202,15 +214,37 @@ void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec
   unpack(plan, in, arrays);
 }
 
-void Decomposition::gather_to_root(std::span<const std::span<Vec3>> arrays) const {
-  if (size_ == 1) return;
-  const int m = 3 * static_cast<int>(arrays.size());
-  const std::vector<double> out = pack(all_nodes_, rank_, arrays);
-  std::vector<double> in(rank_ == 0 ? all_nodes_.by_rank.size() * m : 0);
-  const auto [counts, displs] = layout(all_nodes_, m);
-  MPI_Gatherv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, in.data(), counts.data(), displs.data(),
-              MPI_DOUBLE, 0, comm_);
-  if (rank_ == 0) unpack(all_nodes_, in, arrays);
+std::vector<std::vector<Vec3>> Decomposition::gather_to_root(std::span<const std::span<const Vec3>> arrays) const {
+  const size_t m = arrays.size();
+  if (size_ == 1) {
+    std::vector<std::vector<Vec3>> whole;
+    for (const auto& a : arrays) whole.emplace_back(a.begin(), a.end());
+    return whole;
+  }
+  // Each node from its owner, as rows of the whole model's node order.
+  std::vector<Index> rows;
+  for (Index n : touched_nodes_)
+    if (node_owner(n) == rank_) rows.push_back(model_.whole_node(n));
+  std::vector<double> values(rows.size() * 3 * m);
+  for (size_t r = 0, k = 0; r < touched_nodes_.size(); ++r) {
+    const Index n = touched_nodes_[r];
+    if (node_owner(n) != rank_) continue;
+    for (size_t a = 0; a < m; ++a)
+      for (int c = 0; c < 3; ++c) values[(k * m + a) * 3 + c] = arrays[a][n][c];
+    ++k;
+  }
+  // The local ids ascend with the whole ids, so the rows do too.
+  const std::vector<double> all =
+      to_root(rows, values, static_cast<int>(3 * m), model_.whole_nodes(), comm_);
+  std::vector<std::vector<Vec3>> whole(m);
+  if (rank_ != 0) return whole;
+  const size_t nn = model_.whole_nodes();
+  for (size_t a = 0; a < m; ++a) {
+    whole[a].resize(nn);
+    for (size_t i = 0; i < nn; ++i)
+      for (int c = 0; c < 3; ++c) whole[a][i][c] = all[(i * m + a) * 3 + c];
+  }
+  return whole;
 }
 
 void Decomposition::sum(std::span<ExactSum> values) const {
@@ -219,6 +253,15 @@ void Decomposition::sum(std::span<ExactSum> values) const {
 
 void Decomposition::broadcast(std::span<double> values, int root) const {
   if (size_ > 1) MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, root, comm_);
+}
+
+std::string Decomposition::broadcast(std::string text, int root) const {
+  if (size_ == 1) return text;
+  int n = static_cast<int>(text.size());
+  MPI_Bcast(&n, 1, MPI_INT, root, comm_);
+  text.resize(n);
+  MPI_Bcast(text.data(), n, MPI_CHAR, root, comm_);
+  return text;
 }
 
 std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {

@@ -2,8 +2,10 @@
 // How the time loop is shared between MPI ranks (DESIGN.md "Parallel model",
 // docs/parallel.md "The decomposed time loop").
 //
-// Every rank builds the same global model; the work is divided, the data is
-// replicated. The elements are cut into granules of ElementForces::kGranule
+// A rank holds either its part of the model (owned elements and ghost
+// layer, Model::Part: scenes without contact and fracture) or the whole
+// model; either way the work is divided as follows, on the part's local
+// ids, the granules and blocks being those of the whole model. The elements are cut into granules of ElementForces::kGranule
 // consecutive elements (consecutive in the locality order, so a granule is a
 // compact piece of a body) and METIS k-way partitions the granule graph (two
 // granules adjacent when they share nodes, weighted by the number of shared
@@ -59,8 +61,9 @@ struct SharedNodes {
 class Decomposition {
  public:
   /// Partitions `model`'s elements over the ranks of `comm` (every rank
-  /// computes the same partition; no communication). Throws InputError when
-  /// the mesh has fewer granules than ranks.
+  /// computes the same partition; no communication; a part of the model
+  /// brings the start-up rank's). Throws InputError when the mesh has fewer
+  /// granules than ranks.
   Decomposition(const Model& model, MPI_Comm comm);
   ~Decomposition();
   Decomposition(const Decomposition&) = delete;
@@ -98,7 +101,9 @@ class Decomposition {
   /// Elements of the owned granules, ascending.
   std::span<const Index> owned_element_ids() const { return owned_element_ids_; }
   /// Whether element e is owned here.
-  bool owns_element(Index e) const { return owns_granule(e / ElementForces::kGranule); }
+  bool owns_element(Index e) const { return owns_granule(model_.whole_element(e) / ElementForces::kGranule); }
+  /// The rank owning element e (held here).
+  int element_rank(Index e) const { return granule_rank_[model_.whole_element(e) / ElementForces::kGranule]; }
   /// The smallest rank touching the node.
   int node_owner(Index node) const { return size_ == 1 ? 0 : node_ranks_[node_rank_offsets_[node]]; }
   Index owned_elements() const { return owned_elements_; }
@@ -123,8 +128,9 @@ class Decomposition {
   SharedNodes shared_nodes(std::vector<Index> nodes) const;
   /// After the call every rank holds the owners' values of the plan's nodes in `arrays`.
   void share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) const;
-  /// Rank 0 receives the owners' values of every node (the others' arrays are unchanged).
-  void gather_to_root(std::span<const std::span<Vec3>> arrays) const;
+  /// The owners' values of every node of the whole model, in its node order,
+  /// on rank 0 (empty arrays elsewhere; collective).
+  std::vector<std::vector<Vec3>> gather_to_root(std::span<const std::span<const Vec3>> arrays) const;
 
   /// In place: every rank's accumulators become their sum over the ranks
   /// (exact; ~570 bytes per accumulator, whatever the model).
@@ -133,6 +139,8 @@ class Decomposition {
   static std::size_t sum_bytes(std::size_t count) { return count * (sizeof(std::int64_t) * ExactSum::kDigits + 8); }
   /// In place: `root`'s values on every rank.
   void broadcast(std::span<double> values, int root) const;
+  /// `root`'s text on every rank.
+  std::string broadcast(std::string text, int root) const;
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
   /// Global minimum (exact in any order).
@@ -158,8 +166,11 @@ class Decomposition {
   std::vector<Index> home_granule_;               ///< per node
   std::vector<Index> home_offsets_, home_nodes_;  ///< CSR over the owned granules' index k
   std::unique_ptr<Halo> halo_;
-  SharedNodes all_nodes_;
 };
+
+/// Throws InputError when `model` has fewer granules than `ranks`, saying how
+/// many ranks it can take.
+void check_ranks(const Model& model, int ranks);
 
 template <class Body>
 void Decomposition::for_touched(Index num_nodes, Body body) const {

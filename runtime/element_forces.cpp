@@ -61,33 +61,66 @@ ElementStep element_stable_step(const Model& model, std::span<const Vec3> x, Ind
 
 ElementForces::ElementForces(const Model& model) : model_(model) { rebuild(); }
 
-void ElementForces::rebuild() {
-  const Mesh& mesh = model_.mesh;
+std::vector<int> block_colors(const Mesh& mesh) {
   const Index ne = mesh.num_elements();
   const int k = mesh.nodes_per_element();
-  const Index nblocks = (ne + kBlock - 1) / kBlock;
+  const Index nblocks = (ne + ElementForces::kBlock - 1) / ElementForces::kBlock;
   std::vector<Index> offsets(nblocks + 1, 0), nodes;
   nodes.reserve(static_cast<size_t>(ne) * k);
   for (Index b = 0; b < nblocks; ++b) {
     const size_t first = nodes.size();
-    for (Index e = b * kBlock; e < std::min(ne, (b + 1) * kBlock); ++e)
+    for (Index e = b * ElementForces::kBlock; e < std::min(ne, (b + 1) * ElementForces::kBlock); ++e)
       for (int a = 0; a < k; ++a) nodes.push_back(mesh.element(e)[a]);
     std::sort(nodes.begin() + first, nodes.end());
     nodes.erase(std::unique(nodes.begin() + first, nodes.end()), nodes.end());
     offsets[b + 1] = static_cast<Index>(nodes.size());
   }
-  coloring_ = greedy_coloring(offsets, nodes, mesh.num_nodes());
-  granule_energy_.assign((ne + kGranule - 1) / kGranule, 0.0);
+  return greedy_coloring(offsets, nodes, mesh.num_nodes()).color;
+}
+
+void ElementForces::rebuild() {
+  const Index ne = model_.mesh.num_elements();
+  // The whole model's blocks and granules that hold elements here (all of
+  // them on the whole model), ascending.
+  blocks_.clear();
+  granules_.clear();
+  for (Index e = 0; e < ne; ++e) {
+    const Index w = model_.whole_element(e);
+    if (blocks_.empty() || blocks_.back() != w / kBlock) blocks_.push_back(w / kBlock);
+    if (granules_.empty() || granules_.back() != w / kGranule) granules_.push_back(w / kGranule);
+  }
+  const Index nblocks = static_cast<Index>(blocks_.size());
+  coloring_ = coloring_from(model_.is_part() ? model_.part.block_color : block_colors(model_.mesh));
+  SHATTER_REQUIRE(static_cast<Index>(coloring_.color.size()) == nblocks,
+                  "ElementForces: " << coloring_.color.size() << " block colors for " << nblocks << " blocks");
+  granule_energy_.assign(granules_.size(), 0.0);
   block_dt_.assign(nblocks, HUGE_VAL);
   block_min_J_.assign(nblocks, HUGE_VAL);
   block_worst_.assign(nblocks, -1);
   // Every element, block by block, until restrict_to().
-  subset_.resize(ne);
-  for (Index e = 0; e < ne; ++e) subset_[e] = e;
-  subset_offsets_.resize(nblocks + 1);
-  for (Index b = 0; b <= nblocks; ++b) subset_offsets_[b] = std::min(ne, b * kBlock);
+  std::vector<Index> all(ne);
+  for (Index e = 0; e < ne; ++e) all[e] = e;
+  set_subset(all);
   zero_nodes_.clear();
   split_phases(std::vector<char>(nblocks, 0));
+}
+
+Index ElementForces::block_of(Index e) const {
+  return static_cast<Index>(std::lower_bound(blocks_.begin(), blocks_.end(), model_.whole_element(e) / kBlock) -
+                            blocks_.begin());
+}
+
+double ElementForces::granule_energy(Index granule) const {
+  const auto it = std::lower_bound(granules_.begin(), granules_.end(), granule);
+  return it != granules_.end() && *it == granule ? granule_energy_[it - granules_.begin()] : 0.0;
+}
+
+void ElementForces::set_subset(std::span<const Index> elements) {
+  const Index nblocks = static_cast<Index>(blocks_.size());
+  subset_.assign(elements.begin(), elements.end());
+  subset_offsets_.assign(nblocks + 1, 0);
+  for (Index e : subset_) ++subset_offsets_[block_of(e) + 1];
+  for (Index b = 0; b < nblocks; ++b) subset_offsets_[b + 1] += subset_offsets_[b];
 }
 
 void ElementForces::split_phases(const std::vector<char>& late) {
@@ -105,11 +138,8 @@ void ElementForces::restrict_to(std::span<const Index> elements, std::span<const
                                 std::span<const Index> late_nodes) {
   const Index nblocks = static_cast<Index>(block_dt_.size());
   SHATTER_REQUIRE(!nodes.empty() || elements.empty(), "ElementForces::restrict_to: elements without nodes");
-  subset_.assign(elements.begin(), elements.end());
+  set_subset(elements);
   zero_nodes_.assign(nodes.begin(), nodes.end());
-  subset_offsets_.assign(nblocks + 1, 0);
-  for (Index e : subset_) ++subset_offsets_[e / kBlock + 1];
-  for (Index b = 0; b < nblocks; ++b) subset_offsets_[b + 1] += subset_offsets_[b];
 
   // Late blocks: those reading a late node, then closed under the color order.
   const Mesh& mesh = model_.mesh;
@@ -181,9 +211,9 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     Index worst = -1;
     // One granule at a time: its energy is summed on its own.
     for (const Index* g0 = first; g0 < last;) {
-      const Index granule = *g0 / kGranule;
+      const Index granule = model_.whole_element(*g0) / kGranule;
       const Index* g1 = g0;
-      while (g1 < last && *g1 / kGranule == granule) ++g1;
+      while (g1 < last && model_.whole_element(*g1) / kGranule == granule) ++g1;
       double energy = 0;
       if (mesh.order == 1) {
         for (const Index* e = g0; e < g1;) {
@@ -211,7 +241,7 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
           }
         }
       }
-      granule_energy_[granule] = energy;
+      granule_energy_[std::lower_bound(granules_.begin(), granules_.end(), granule) - granules_.begin()] = energy;
       g0 = g1;
     }
     if (mesh.order == 1) dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt

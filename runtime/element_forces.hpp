@@ -65,8 +65,9 @@ class ElementForces {
   Index early_blocks() const { return static_cast<Index>(phase_items_[0].size()); }
   Index late_blocks() const { return static_cast<Index>(phase_items_[1].size()); }
 
-  /// Strain energy of each granule's computed elements in the last compute(), J.
-  std::span<const double> granule_energy() const { return granule_energy_; }
+  /// Strain energy of the computed elements of granule `granule` (of the
+  /// whole model) in the last compute(), J; 0 for a granule not held here.
+  double granule_energy(Index granule) const;
 
   /// f_int = dE/dx at positions x (overwrites f_int, size = nodes). The
   /// result's strain_energy is the exact sum of granule_energy(),
@@ -82,16 +83,30 @@ class ElementForces {
 
  private:
   void split_phases(const std::vector<char>& late);
+  /// The block (index into blocks_) of element e.
+  Index block_of(Index e) const;
+  /// Compute `elements` (ascending), grouped by block.
+  void set_subset(std::span<const Index> elements);
 
   const Model& model_;
-  Coloring coloring_;
+  /// The whole model's blocks of kBlock and granules of kGranule elements
+  /// that hold elements of this model, ascending (all of them on the whole model).
+  std::vector<Index> blocks_, granules_;
+  Coloring coloring_;  ///< of blocks_: the whole model's coloring
   std::vector<Index> subset_offsets_, subset_;  ///< CSR per block: its elements to compute
   std::vector<Index> zero_nodes_;               ///< nodes to zero after restrict_to (empty: all)
   /// Per phase (early, late): the blocks in color order, CSR by color.
   std::array<std::vector<Index>, 2> phase_items_, phase_offsets_;
-  mutable std::vector<double> granule_energy_, block_dt_, block_min_J_;
+  mutable std::vector<double> granule_energy_;  ///< per granules_
+  mutable std::vector<double> block_dt_, block_min_J_;
   mutable std::vector<Index> block_worst_;
 };
+
+/// The colors of the whole mesh's blocks of ElementForces::kBlock consecutive
+/// elements: greedy, in block order, blocks sharing a node differ. A part
+/// of the model keeps these (Model::Part::block_color), so a node receives
+/// its contributions in the same order on every rank.
+std::vector<int> block_colors(const Mesh& mesh);
 
 /// One element's stable step at positions x, as ElementForces::compute takes
 /// it (its minimum over the elements is ElementLoopResult::stable_dt), and its

@@ -1,5 +1,6 @@
 #include "runtime/model.hpp"
 
+#include <algorithm>
 #include <array>
 #include <sstream>
 
@@ -7,7 +8,9 @@
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
 #include "mesh/reorder.hpp"
+#include "runtime/decomposition.hpp"
 #include "runtime/mesh_broadcast.hpp"
+#include "runtime/model_part.hpp"
 
 namespace shatter {
 
@@ -37,17 +40,16 @@ Mesh mesh_bodies(const Scene& scene) {
   return mesh;
 }
 
-/// mesh_bodies on rank 0 of `comm`, broadcast to the others; a failure there
-/// is thrown on every rank (InputError stays InputError), so the ranks end
-/// together.
-Mesh mesh_on_root(const Scene& scene, MPI_Comm comm) {
+/// `f` on rank 0 of `comm`; a failure there is thrown on every rank
+/// (InputError stays InputError), so the ranks end together. Collective.
+template <class F>
+void on_root(MPI_Comm comm, F f) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  Mesh mesh;
   std::string error;
   int kind = 0;  // 0 none, 1 Error, 2 InputError
   if (rank == 0) try {
-      mesh = mesh_bodies(scene);
+      f();
     } catch (const InputError& e) {
       error = e.what(), kind = 2;
     } catch (const std::exception& e) {
@@ -61,9 +63,10 @@ Mesh mesh_on_root(const Scene& scene, MPI_Comm comm) {
     if (head[0] == 2) throw InputError(error);
     throw Error(error);
   }
-  broadcast_mesh(mesh, 0, comm);
-  return mesh;
 }
+
+/// The constants, masses, initial and boundary conditions of the model on `mesh`.
+void complete_model(Model& m);
 
 }  // namespace
 
@@ -74,8 +77,29 @@ Model build_model(const Scene& scene, MPI_Comm comm) {
     m.materials.push_back(NeoHookean::from_young_poisson(ms.young, ms.poisson, ms.density));
   int ranks = 1;
   if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
-  m.mesh = ranks > 1 ? mesh_on_root(scene, comm) : mesh_bodies(scene);
+  if (ranks == 1) {
+    m.mesh = mesh_bodies(scene);
+    complete_model(m);
+  } else if (scene.contact || scene.fracture_enabled()) {
+    // Contact and fracture still need the whole model on every rank (docs/parallel.md "Limits").
+    on_root(comm, [&] { m.mesh = mesh_bodies(scene); });
+    broadcast_mesh(m.mesh, 0, comm);
+    complete_model(m);
+  } else {
+    on_root(comm, [&] {
+      m.mesh = mesh_bodies(scene);
+      complete_model(m);
+      check_ranks(m, ranks);
+    });
+    distribute_parts(m, comm);
+  }
+  return m;
+}
 
+namespace {
+
+void complete_model(Model& m) {
+  const Scene& scene = m.scene;
   const Mesh& mesh = m.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();
@@ -166,8 +190,9 @@ Model build_model(const Scene& scene, MPI_Comm comm) {
       throw InputError(scene.file + ": " + bc.key + ".region: the box holds no node of body '" +
                        scene.bodies[bc.body].name + "'; expected a box around some of its nodes");
   }
-  return m;
 }
+
+}  // namespace
 
 void recompute_node_masses(Model& model, const std::vector<Index>& nodes) {
   const Mesh& mesh = model.mesh;
@@ -184,13 +209,16 @@ void recompute_node_masses(Model& model, const std::vector<Index>& nodes) {
   }
 }
 
+Index Model::local_element(Index whole) const {
+  if (!is_part()) return whole < mesh.num_elements() ? whole : -1;
+  const auto it = std::lower_bound(part.element_index.begin(), part.element_index.end(), whole);
+  return it != part.element_index.end() && *it == whole ? static_cast<Index>(it - part.element_index.begin()) : -1;
+}
+
 std::size_t model_bytes(const Model& m) {
-  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  const Mesh& mesh = m.mesh;
-  return b(mesh.reference) + b(mesh.node_gid) + b(mesh.node_body) + b(mesh.conn) + b(mesh.elem_gid) +
-         b(mesh.elem_body) + b(mesh.elem_material) + b(mesh.node_elem_offsets) + b(mesh.node_elem) +
-         b(m.tet4_Dm_inv) + b(m.tet10_ref) + b(m.element_volume) + b(m.element_node_mass) + b(m.mass) +
-         b(m.bc_mask) + b(m.bc_velocity) + b(m.initial_velocity);
+  std::size_t bytes = 0;
+  for_each_array(m, [&](const auto& v) { bytes += v.capacity() * sizeof(v[0]); });
+  return bytes;
 }
 
 }  // namespace shatter

@@ -30,15 +30,51 @@ struct Model {
   std::vector<Vec3> bc_velocity;             ///< per node: prescribed velocity components, m/s
   std::vector<Vec3> initial_velocity;        ///< per node, m/s
 
-  /// Total mass and volume of each body.
+  /// Total mass and volume of each body (of the whole model).
   std::vector<double> body_mass, body_volume;
+
+  /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
+  /// its owned elements and their ghost layer, ascending in the whole
+  /// model's order, and the nodes they use. Empty `element_index`: this
+  /// model is the whole one (one rank, or a scene every rank holds whole).
+  struct Part {
+    std::vector<Index> element_index;  ///< per element: its index in the whole model
+    std::vector<Index> node_index;     ///< per node: its index in the whole model
+    std::vector<int> block_color;      ///< per element block held here (ascending): the whole model's block color
+    std::vector<int> granule_rank;     ///< per granule of the whole model: its owner (METIS)
+    std::vector<Index> node_rank_offsets;
+    std::vector<int> node_ranks;       ///< CSR per node: the ranks whose owned elements use it, ascending
+    std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
+    Index whole_elements = 0, whole_nodes = 0, whole_bc_nodes = 0;
+    std::uint64_t fingerprint = 0;     ///< model_fingerprint() of the whole model
+  } part;
+  bool is_part() const { return !part.element_index.empty(); }
+  Index whole_element(Index e) const { return is_part() ? part.element_index[e] : e; }
+  Index whole_node(Index n) const { return is_part() ? part.node_index[n] : n; }
+  /// The local index of the whole model's element `whole`, -1 when not held here.
+  Index local_element(Index whole) const;
+  Index whole_elements() const { return is_part() ? part.whole_elements : mesh.num_elements(); }
+  Index whole_nodes() const { return is_part() ? part.whole_nodes : mesh.num_nodes(); }
 };
 
+/// f(array) for every array of the model (model_bytes; a part travels in this order).
+template <class M, class F>
+void for_each_array(M& m, F f) {
+  f(m.mesh.reference), f(m.mesh.node_gid), f(m.mesh.node_body), f(m.mesh.conn), f(m.mesh.elem_gid);
+  f(m.mesh.elem_body), f(m.mesh.elem_material), f(m.mesh.node_elem_offsets), f(m.mesh.node_elem);
+  f(m.tet4_Dm_inv), f(m.tet10_ref), f(m.element_volume), f(m.element_node_mass), f(m.mass), f(m.bc_mask);
+  f(m.bc_velocity), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
+  f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
+  f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index);
+}
+
 /// Mesh every body, check the meshes, and compute every constant of the model.
-/// On several ranks of `comm` (collective) rank 0 meshes and sends the mesh
-/// to the others, which compute the constants from it: Gmsh runs once, and
-/// every rank holds the same model. Throws InputError (bad scene or mesh) on
-/// every rank.
+/// On several ranks of `comm` (collective) rank 0 meshes and computes the
+/// whole model. A scene without contact and fracture is then cut: rank 0
+/// partitions it (METIS granules) and sends every rank its part (owned
+/// elements and ghost layer, Model::Part), keeping its own; otherwise every
+/// rank receives the mesh and computes the whole model. Throws InputError
+/// (bad scene or mesh) on every rank.
 Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF);
 
 /// Recompute the lumped masses of `nodes` from element_node_mass (after node splitting).

@@ -11,19 +11,22 @@ RowBlock row_block(Index total, int rank, int ranks) {
   return {edge(rank), edge(rank + 1) - edge(rank)};
 }
 
-std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const double> values, int width,
-                                  Index total, MPI_Comm comm) {
+namespace {
+
+/// The rows to the ranks whose blocks hold them, block(d) being rank d's.
+template <class Block>
+std::vector<double> to_blocks(std::span<const Index> rows, std::span<const double> values, int width,
+                              MPI_Comm comm, Block block) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
   SHATTER_REQUIRE(values.size() == rows.size() * width,
                   "to_row_blocks: " << values.size() << " values for " << rows.size() << " rows of " << width);
-  if (ranks == 1) return {values.begin(), values.end()};
   // The rows are ascending and the blocks contiguous: the rows for rank d
   // are one run of `rows`.
   std::vector<int> send_rows(ranks, 0), recv_rows(ranks, 0);
   for (int d = 0, k = 0; d < ranks; ++d) {
-    const RowBlock b = row_block(total, d, ranks);
+    const RowBlock b = block(d);
     const int begin = k;
     while (k < static_cast<int>(rows.size()) && rows[k] < b.first + b.count) ++k;
     send_rows[d] = k - begin;
@@ -35,7 +38,7 @@ std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const d
     recv_at[d] = recv_at[d - 1] + recv_rows[d - 1];
   }
   const int received = recv_at[ranks - 1] + recv_rows[ranks - 1];
-  const RowBlock mine = row_block(total, rank, ranks);
+  const RowBlock mine = block(rank);
   SHATTER_REQUIRE(received == mine.count, "to_row_blocks: rank " << rank << " received " << received
                                                                   << " rows for its block of " << mine.count);
   static_assert(sizeof(Index) == sizeof(int));
@@ -56,6 +59,24 @@ std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const d
     std::copy_n(in.begin() + static_cast<size_t>(i) * width, width, out.begin() + static_cast<size_t>(r) * width);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const double> values, int width,
+                                  Index total, MPI_Comm comm) {
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  if (ranks == 1) return {values.begin(), values.end()};
+  return to_blocks(rows, values, width, comm, [&](int d) { return row_block(total, d, ranks); });
+}
+
+std::vector<double> to_root(std::span<const Index> rows, std::span<const double> values, int width, Index total,
+                            MPI_Comm comm) {
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  if (ranks == 1) return {values.begin(), values.end()};
+  return to_blocks(rows, values, width, comm, [&](int d) { return d == 0 ? RowBlock{0, total} : RowBlock{total, 0}; });
 }
 
 }  // namespace shatter

@@ -27,4 +27,9 @@ RowBlock row_block(Index total, int rank, int ranks);
 std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const double> values, int width,
                                   Index total, MPI_Comm comm);
 
+/// As to_row_blocks, with every row going to rank 0 (checkpoints): rank 0
+/// returns the [total x width] array, the others an empty one.
+std::vector<double> to_root(std::span<const Index> rows, std::span<const double> values, int width, Index total,
+                            MPI_Comm comm);
+
 }  // namespace shatter

@@ -34,7 +34,7 @@ Simulation::Simulation(Model& model, RunOptions options)
       dec_(std::make_unique<Decomposition>(model, opt_.ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF)),
       elements_(model) {
   const Mesh& mesh = model_.mesh;
-  model_fingerprint_ = model_fingerprint(model_);
+  model_fingerprint_ = whole_fingerprint(model_);
   if (dec_->distributed()) {
     // The ranks' models must be one: the CLI builds them from rank 0's mesh
     // (build_model on the world); a caller that meshed on every rank may not.
@@ -45,7 +45,7 @@ Simulation::Simulation(Model& model, RunOptions options)
                   "between processes)");
   }
   const Index n = mesh.num_nodes();
-  model_nodes_ = n;
+  model_nodes_ = model_.whole_nodes();
   x_ = mesh.reference;
   v_ = model_.initial_velocity;
   a_.assign(n, Vec3::Zero());
@@ -104,28 +104,33 @@ void Simulation::compute_forces(long step, double time, const std::function<void
   if (dec_->distributed()) {
     // The worst element over all ranks (NaN first, then the smallest det F,
     // then the smallest index, as on one rank).
+    // (By the whole model's element index: a part's local ones differ.)
     struct {
       double J;
       int e;
     } worst{std::isnan(last_elements_.min_jacobian) ? -HUGE_VAL : last_elements_.min_jacobian,
-            last_elements_.worst_element < 0 ? std::numeric_limits<int>::max() : last_elements_.worst_element};
+            last_elements_.worst_element < 0 ? std::numeric_limits<int>::max()
+                                             : model_.whole_element(last_elements_.worst_element)};
     MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE_INT, MPI_MINLOC, dec_->comm());
     last_elements_.min_jacobian = worst.J == -HUGE_VAL ? std::nan("") : worst.J;
     last_elements_.worst_element = worst.e == std::numeric_limits<int>::max() ? -1 : worst.e;
   }
   if (!(last_elements_.min_jacobian > 0)) {
-    const Index e = last_elements_.worst_element;
-    Vec3 centre = Vec3::Zero();
-    // The element's owner has its current positions.
-    if (e >= 0 && dec_->owns_element(e))
+    const double J = last_elements_.min_jacobian;
+    // Its owner has its current positions, its id and body.
+    const std::string where = from_owner(last_elements_.worst_element, [&](Index e) {
+      Vec3 centre = Vec3::Zero();
       for (int a = 0; a < 4; ++a) centre += 0.25 * x_[model_.mesh.element(e)[a]];
-    if (e >= 0) dec_->broadcast({centre.data(), 3}, dec_->granule_rank(e / ElementForces::kGranule));
+      std::ostringstream os;
+      os << "element " << model_.mesh.elem_gid[e] << " (body '" << model_.scene.bodies[model_.mesh.elem_body[e]].name
+         << "') " << (std::isnan(J) ? "has NaN coordinates" : "is inverted") << " (det F = " << J << ") near ("
+         << centre.x() << ", " << centre.y() << ", " << centre.z() << ")";
+      return os.str();
+    });
     std::ostringstream os;
-    os << "step " << step << ", t = " << time << " s: element " << (e >= 0 ? model_.mesh.elem_gid[e] : -1)
-       << " (body '" << (e >= 0 ? model_.scene.bodies[model_.mesh.elem_body[e]].name : "?") << "') "
-       << (std::isnan(last_elements_.min_jacobian) ? "has NaN coordinates" : "is inverted") << " (det F = "
-       << last_elements_.min_jacobian << ") near (" << centre.x() << ", " << centre.y() << ", " << centre.z()
-       << "); try a smaller time.safety or a finer mesh";
+    os << "step " << step << ", t = " << time << " s: "
+       << (where.empty() ? std::string(std::isnan(J) ? "NaN coordinates" : "an inverted element") : where)
+       << "; try a smaller time.safety or a finer mesh";
     throw Error(os.str());
   }
   check_step_collapse(step, time);
@@ -335,8 +340,7 @@ void Simulation::update_ledger() {
   });
   std::array<ExactSum, kSums> t;
   std::copy(nodes.begin(), nodes.end(), t.begin());
-  const std::span<const double> strain = elements_.granule_energy();
-  for (Index gr : dec_->owned_granules()) t[kStrain] += strain[gr];
+  for (Index gr : dec_->owned_granules()) t[kStrain] += elements_.granule_energy(gr);
   std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);
   step_work_ = {};
   timed(comm_seconds_, [&] { dec_->sum(t); });

@@ -116,7 +116,8 @@ class Simulation {
 
   /// Copies the state between two steps into `state` (reusing its storage).
   void save_state(SimulationState& state) const;
-  /// Continues from `state` (of this model): the next
+  /// Continues from `state` (of this model; on a part of the model, the whole
+  /// model's state, as a checkpoint holds it): the next
   /// step() is the one the saved run would have taken, bitwise, and run()
   /// appends to the outputs in opt.out_dir (checkpoint.hpp). Throws Error when
   /// the array sizes do not match the model.
@@ -146,6 +147,9 @@ class Simulation {
   /// throws Error naming the element that sets it, where it is and the likely
   /// cause (simulation_checks.cpp): the run would crawl without end.
   void check_step_collapse(long step, double time);
+  /// what(e) on the owner of the whole model's element `whole` (e: its local
+  /// index there), on every rank (collective); "" for whole < 0.
+  std::string from_owner(Index whole, const std::function<std::string(Index)>& what) const;
   /// An energy term not finite or beyond kEnergyOverflow throws Error naming
   /// the terms and a node (simulation_checks.cpp); in the initial state
   /// (step 0) it is bad input, InputError.
@@ -169,6 +173,10 @@ class Simulation {
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
   void save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason = "");
+  /// restore_state on a part of the model: `s` is the whole model's state.
+  void restore_part(const SimulationState& s);
+  /// restore_state's step, time, controller and ledger.
+  void restore_scalars(const SimulationState& s);
   /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.
   double next_dt();
 

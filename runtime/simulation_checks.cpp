@@ -20,31 +20,36 @@ void Simulation::check_step_collapse(long step, double time) {
     double dt;
     int e;
   } least{HUGE_VAL, std::numeric_limits<int>::max()};
-  const Index ne = model_.mesh.num_elements();
-  for (Index e = 0; e < ne; ++e)
-    if (dec_->owns_element(e)) {
-      const double dt = element_stable_step(model_, x_, e).dt;
-      if (dt < least.dt) least = {dt, static_cast<int>(e)};
-    }
+  for (Index e : dec_->owned_element_ids()) {
+    const double dt = element_stable_step(model_, x_, e).dt;
+    const int whole = static_cast<int>(model_.whole_element(e));
+    if (dt < least.dt || (dt == least.dt && whole < least.e)) least = {dt, whole};
+  }
   if (dec_->distributed()) MPI_Allreduce(MPI_IN_PLACE, &least, 1, MPI_DOUBLE_INT, MPI_MINLOC, dec_->comm());
   StepCollapse c;
   c.dt = stable_dt_;
   c.dt0 = stable_dt0_;
-  if (least.e != std::numeric_limits<int>::max()) {
-    c.element = least.e;
+  if (least.e == std::numeric_limits<int>::max()) throw Error(step_collapse_diagnosis(model_, c, step, time));
+  // Its owner has its current positions and its part of the mesh.
+  throw Error(from_owner(least.e, [&](Index e) {
+    c.element = e;
     c.element_dt = least.dt;
-    // Its owner has its current positions.
-    double where[4] = {0, 0, 0, 0};
-    if (dec_->owns_element(c.element)) {
-      for (int a = 0; a < 4; ++a) c.centre += 0.25 * x_[model_.mesh.element(c.element)[a]];
-      where[0] = c.centre.x(), where[1] = c.centre.y(), where[2] = c.centre.z();
-      where[3] = element_stable_step(model_, x_, c.element).J;
-    }
-    dec_->broadcast({where, 4}, dec_->granule_rank(c.element / ElementForces::kGranule));
-    c.centre = Vec3(where[0], where[1], where[2]);
-    c.J = where[3];
+    for (int a = 0; a < 4; ++a) c.centre += 0.25 * x_[model_.mesh.element(e)[a]];
+    c.J = element_stable_step(model_, x_, e).J;
+    return step_collapse_diagnosis(model_, c, step, time);
+  }));
+}
+
+std::string Simulation::from_owner(Index whole, const std::function<std::string(Index)>& what) const {
+  if (whole < 0) return "";
+  const int owner = dec_->granule_rank(whole / ElementForces::kGranule);
+  std::string text;
+  if (owner == dec_->rank()) {
+    const Index e = model_.local_element(whole);
+    SHATTER_REQUIRE(e >= 0, "from_owner: element " << whole << " is not held by its owner");
+    text = what(e);
   }
-  throw Error(step_collapse_diagnosis(model_, c, step, time));
+  return dec_->broadcast(std::move(text), owner);
 }
 
 void Simulation::check_ledger() {

@@ -63,6 +63,10 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   const int k = mesh.nodes_per_element();
   const bool cracks = !elem_fragment.empty();
   const std::span<const Index> nodes = dec_->owned_nodes(), elems = dec_->owned_element_ids();
+  // The rows of the whole model (a part's local ids ascend with them).
+  std::vector<Index> node_ids(nodes.size()), elem_ids(elems.size());
+  for (size_t r = 0; r < nodes.size(); ++r) node_ids[r] = model_.whole_node(nodes[r]);
+  for (size_t r = 0; r < elems.size(); ++r) elem_ids[r] = model_.whole_element(elems[r]);
   constexpr int kNodeWidth = 9;  // X, u, v
   std::vector<double> node_rows(nodes.size() * kNodeWidth);
   parallel_for_each(static_cast<Index>(nodes.size()), [&](Index r) {
@@ -78,7 +82,7 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   parallel_for_each(static_cast<Index>(elems.size()), [&](Index r) {
     const Index e = elems[r];
     double* o = elem_rows.data() + static_cast<size_t>(r) * width;
-    for (int a = 0; a < k; ++a) o[a] = mesh.element(e)[a];
+    for (int a = 0; a < k; ++a) o[a] = model_.whole_node(mesh.element(e)[a]);
     double* s6 = o + k;
     element_cauchy_stress6(model_, x_, e, s6);
     Mat3 sigma;
@@ -88,8 +92,8 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
     if (cracks) o[k + 8] = elem_fragment[e], o[k + 9] = damage[e];
   });
   const MPI_Comm comm = dec_->distributed() ? dec_->comm() : MPI_COMM_SELF;
-  const std::vector<double> nb = to_row_blocks(nodes, node_rows, kNodeWidth, mesh.num_nodes(), comm);
-  const std::vector<double> eb = to_row_blocks(elems, elem_rows, width, mesh.num_elements(), comm);
+  const std::vector<double> nb = to_row_blocks(node_ids, node_rows, kNodeWidth, model_.whole_nodes(), comm);
+  const std::vector<double> eb = to_row_blocks(elem_ids, elem_rows, width, model_.whole_elements(), comm);
 
   // This rank's block as a mesh (connectivity in global node rows) and frame.
   const size_t bn = nb.size() / kNodeWidth, be = eb.size() / width;
@@ -185,8 +189,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(8 + kStepWorks) : 0));
   // The contact stage's exchanges included (contact_exchange_time).
   j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
-  j.add("nodes", static_cast<long>(model_.mesh.num_nodes()));
-  j.add("elements", static_cast<long>(model_.mesh.num_elements()));
+  j.add("nodes", static_cast<long>(model_.whole_nodes()));
+  j.add("elements", static_cast<long>(model_.whole_elements()));
   j.add("element_order", model_.mesh.order);
   j.add("bodies", static_cast<long>(model_.scene.bodies.size()));
   j.add("kinetic", l.kinetic);

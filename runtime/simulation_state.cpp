@@ -9,17 +9,27 @@
 #include "runtime/decomposition.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/simulation.hpp"
+#include "runtime/timed.hpp"
 
 namespace shatter {
 
 void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason) {
   if (dec_->distributed()) {
-    // Every node's values from its owner; reactions through a nodal array.
-    std::vector<Vec3> reaction(model_.mesh.num_nodes(), Vec3::Zero());
-    for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction[bc_nodes_[b]] = s.reaction[b];
-    const std::span<Vec3> arrays[] = {s.x, s.v, s.a, s.f_int, s.f_ext, reaction};
-    dec_->gather_to_root(arrays);
-    for (size_t b = 0; b < bc_nodes_.size(); ++b) s.reaction[b] = reaction[bc_nodes_[b]];
+    // Every node's values from its owner, in the whole model's node order, on
+    // rank 0; the reactions through a nodal array, with a flag per node that has them.
+    const Index n = model_.mesh.num_nodes();
+    std::vector<Vec3> reaction(n, Vec3::Zero()), has(n, Vec3::Zero());
+    for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction[bc_nodes_[b]] = s.reaction[b], has[bc_nodes_[b]].x() = 1;
+    const std::span<const Vec3> arrays[] = {s.x, s.v, s.a, s.f_int, s.f_ext, reaction, has};
+    std::vector<std::vector<Vec3>> whole;
+    timed(comm_seconds_, [&] { whole = dec_->gather_to_root(arrays); });
+    if (dec_->rank() == 0) {
+      s.x = std::move(whole[0]), s.v = std::move(whole[1]), s.a = std::move(whole[2]);
+      s.f_int = std::move(whole[3]), s.f_ext = std::move(whole[4]);
+      s.reaction.clear();
+      for (size_t i = 0; i < whole[6].size(); ++i)
+        if (whole[6][i].x() != 0) s.reaction.push_back(whole[5][i]);
+    }
   }
   std::string failure;
   if (dec_->rank() == 0) try {
@@ -75,22 +85,44 @@ void Simulation::restore_state(const SimulationState& s) {
     if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
     share_plans();
   }
+  if (model_.is_part()) return restore_part(s);
   const size_t n = model_.mesh.num_nodes();
   SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
                       s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
                   "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
                                                   << " reactions, the model " << n << " and " << bc_nodes_.size());
-  step_ = s.step;
-  time_ = s.time;
-  dt_ = s.dt;
-  stable_dt_ = s.stable_dt;
-  step_control_ = s.step_control;
   x_ = s.x;
   v_ = s.v;
   a_ = s.a;
   f_int_ = s.f_int;
   f_ext_ = s.f_ext;
   reaction_ = s.reaction;
+  restore_scalars(s);
+}
+
+void Simulation::restore_part(const SimulationState& s) {
+  // The state of the whole model: this part's nodes and reactions from it.
+  const Model::Part& part = model_.part;
+  const size_t n = part.whole_nodes;
+  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
+                      s.f_ext.size() == n && s.reaction.size() == static_cast<size_t>(part.whole_bc_nodes),
+                  "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
+                                                  << " reactions, the whole model " << n << " and "
+                                                  << part.whole_bc_nodes);
+  for (Index i = 0; i < model_.mesh.num_nodes(); ++i) {
+    const Index w = part.node_index[i];
+    x_[i] = s.x[w], v_[i] = s.v[w], a_[i] = s.a[w], f_int_[i] = s.f_int[w], f_ext_[i] = s.f_ext[w];
+  }
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction_[b] = s.reaction[part.bc_index[b]];
+  restore_scalars(s);
+}
+
+void Simulation::restore_scalars(const SimulationState& s) {
+  step_ = s.step;
+  time_ = s.time;
+  dt_ = s.dt;
+  stable_dt_ = s.stable_dt;
+  step_control_ = s.step_control;
   ledger_ = s.ledger;
   total0_ = s.total0;
   energy_scale_ = s.energy_scale;

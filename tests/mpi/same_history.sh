@@ -7,8 +7,10 @@
 # names the ranks and that the comparison covers what the scene is for:
 #   contact:  the run had contacts, and at 3 ranks every rank resolved pairs;
 #   fracture: cohesive elements were inserted between elements of different
-#             ranks at 3 ranks (cracks crossing subdomain boundaries).
-# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture [--set key=value ...]
+#             ranks at 3 ranks (cracks crossing subdomain boundaries);
+#   volume:   (no contact, no fracture) at 3 ranks each rank held only its
+#             part of the model: model_bytes_per_rank_max below 0.6x that of 1 rank.
+# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture|volume [--set key=value ...]
 set -euo pipefail
 shatter=$1 mpiexec=$2 scene=$3 work=$4 kind=$5
 shift 5
@@ -49,6 +51,11 @@ if [ "$kind" = contact ]; then
   least=$(grep -o '"contact_pairs_per_step_rank_min": [-0-9.e+]*' "$work/r3t1/summary.json" | awk '{print $2}')
   awk -v m="${least:-0}" 'BEGIN { exit !(m > 0) }' || { echo "FAIL: a rank of 3 resolved no contact pairs"; status=1; }
   what="$what, at 3 ranks at least $least pairs per step per rank"
+elif [ "$kind" = volume ]; then
+  bytes() { grep -o '"model_bytes_per_rank_max": [0-9]*' "$work/$1/summary.json" | grep -o '[0-9]*$'; }
+  one=$(bytes r1t1) three=$(bytes r3t1)
+  awk -v a="$three" -v b="$one" 'BEGIN { exit !(a < 0.6 * b) }' && n=1 || n=0
+  what="model bytes per rank $three at 3 ranks, $one at 1"
 else
   n=$(grep -o '"cohesive_elements_across_ranks": [0-9]*' "$work/r3t1/summary.json" | grep -o '[0-9]*$')
   what="$n cohesive elements across ranks at 3 ranks"

@@ -107,9 +107,14 @@ TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
   const std::span<Vec3> arrays[] = {y, z};
   d.share(plan, arrays);
   for (Index n : subset) EXPECT_TRUE(same_bits(y[n], tag(n)) && same_bits(z[n], Vec3(-tag(n)))) << "node " << n;
-  d.gather_to_root(arrays);
+  const std::span<const Vec3> owned[] = {y, z};
+  const std::vector<std::vector<Vec3>> whole = d.gather_to_root(owned);
   if (d.rank() == 0) {
-    for (Index n = 0; n < nn; ++n) EXPECT_TRUE(same_bits(y[n], tag(n))) << "node " << n;
+    ASSERT_EQ(whole[1].size(), static_cast<size_t>(nn));
+    for (Index n = 0; n < nn; ++n)
+      EXPECT_TRUE(same_bits(whole[0][n], tag(n)) && same_bits(whole[1][n], Vec3(-tag(n)))) << "node " << n;
+  } else {
+    EXPECT_TRUE(whole[0].empty());
   }
   // allgather: the ranks' lists in rank order.
   const std::vector<Index> mine(d.rank() + 1, d.rank());
@@ -147,19 +152,22 @@ TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
   // ranks they give the serial total, bit for bit.
   ExactSum total;
   for (Index g : d.owned_granules()) {
-    EXPECT_EQ(restricted.granule_energy()[g], serial.granule_energy()[g]) << "granule " << g;
-    total += restricted.granule_energy()[g];
+    EXPECT_EQ(restricted.granule_energy(g), serial.granule_energy(g)) << "granule " << g;
+    total += restricted.granule_energy(g);
   }
   d.sum({&total, 1});
   EXPECT_EQ(total.value(), whole.strain_energy);
   EXPECT_GT(total.value(), 0.0);
 }
 
-TEST(Decomposition, BuildModelOnSeveralRanksMeshesOnceForAll) {
-  // Rank 0 meshes, every rank gets its mesh: the same model as one built alone.
+TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
+  // Rank 0 meshes and cuts the model; every rank gets its part (owned
+  // elements and ghost layer), which holds the whole model's values and, in
+  // the element loop, gives the whole model's forces bit for bit.
   // (Each rank writes its own scene file: one file written by all would race.)
-  int rank = 0;
+  int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   const Scene scene = test::scene_from_text(
       "build_model_world_rank" + std::to_string(rank),
       "name: world\n"
@@ -169,15 +177,53 @@ TEST(Decomposition, BuildModelOnSeveralRanksMeshesOnceForAll) {
       "bodies:\n"
       "  - name: b\n"
       "    material: steel\n"
-      "    mesh: {shape: sphere, radius: 0.01, element_size: 0.003, order: 2}\n");
-  const Model world = build_model(scene, MPI_COMM_WORLD);
-  std::uint64_t fp[2] = {model_fingerprint(world), ~model_fingerprint(world)};
-  MPI_Allreduce(MPI_IN_PLACE, fp, 2, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
-  EXPECT_EQ(fp[0], ~fp[1]) << "the ranks' models differ";
-  if (rank == 0) {
-    EXPECT_EQ(model_fingerprint(build_model(scene)), model_fingerprint(world));
+      "    mesh: {shape: sphere, radius: 0.01, element_size: 0.0015, order: 2}\n"
+      "    initial_velocity: [1, 0, 0]\n"
+      "    angular_velocity: [0, 0, 300]\n");
+  const Model part = build_model(scene, MPI_COMM_WORLD);
+  const Model whole = build_model(scene);
+  EXPECT_EQ(whole_fingerprint(part), model_fingerprint(whole));
+  EXPECT_EQ(part.is_part(), ranks > 1);
+  EXPECT_EQ(part.whole_elements(), whole.mesh.num_elements());
+  EXPECT_EQ(part.whole_nodes(), whole.mesh.num_nodes());
+  const int k = whole.mesh.nodes_per_element();
+  for (Index e = 0; e < part.mesh.num_elements(); ++e) {
+    const Index w = part.whole_element(e);
+    EXPECT_EQ(part.mesh.elem_gid[e], whole.mesh.elem_gid[w]);
+    EXPECT_EQ(part.element_volume[e], whole.element_volume[w]);
+    for (int a = 0; a < k; ++a) EXPECT_EQ(part.whole_node(part.mesh.element(e)[a]), whole.mesh.element(w)[a]);
   }
-  EXPECT_EQ(world.mesh.node_elem.size(), world.mesh.conn.size());
+  for (Index n = 0; n < part.mesh.num_nodes(); ++n) {
+    const Index w = part.whole_node(n);
+    EXPECT_TRUE(same_bits(part.mesh.reference[n], whole.mesh.reference[w]) &&
+                same_bits(part.initial_velocity[n], whole.initial_velocity[w]))
+        << "node " << n;
+  }
+  const Decomposition d(part, MPI_COMM_WORLD);
+  EXPECT_EQ(static_cast<Index>(d.local_elements().size()), part.mesh.num_elements());
+  EXPECT_EQ(static_cast<Index>(d.held_nodes().size()), part.mesh.num_nodes());
+  long owned = d.owned_elements(), total = 0;
+  MPI_Allreduce(&owned, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(total, whole.mesh.num_elements());
+  if (ranks > 1) EXPECT_LT(part.mesh.num_elements(), whole.mesh.num_elements());
+
+  // The ghost-only positions from their owners, then the forces: the whole model's.
+  std::vector<Vec3> x(part.mesh.num_nodes(), Vec3::Constant(std::nan(""))), f(x.size());
+  for (Index n : d.touched_nodes()) x[n] = deformed(part.mesh.reference[n]);
+  d.begin_ghost_update(x);
+  d.end_ghost_update(x);
+  ElementForces forces(part);
+  if (d.distributed()) forces.restrict_to(d.local_elements(), d.held_nodes(), d.ghost_only_nodes());
+  forces.compute(x, f);
+  std::vector<Vec3> X(whole.mesh.num_nodes()), F(X.size());
+  for (Index n = 0; n < whole.mesh.num_nodes(); ++n) X[n] = deformed(whole.mesh.reference[n]);
+  const ElementLoopResult serial = ElementForces(whole).compute(X, F);
+  for (Index n : d.touched_nodes()) EXPECT_TRUE(same_bits(f[n], F[part.whole_node(n)])) << "node " << n;
+  ExactSum energy;
+  for (Index g : d.owned_granules()) energy += forces.granule_energy(g);
+  d.sum({&energy, 1});
+  EXPECT_EQ(energy.value(), serial.strain_energy);
+
   // A mesh that fails on rank 0 fails on every rank, as bad input.
   Scene bad = scene;
   bad.bodies[0].mesh_file = "/nonexistent/body.msh";

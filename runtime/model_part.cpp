@@ -1,0 +1,165 @@
+#include "runtime/model_part.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#include "kernels/error.hpp"
+#include "mesh/partition.hpp"
+#include "runtime/checkpoint.hpp"
+#include "runtime/element_forces.hpp"
+
+namespace shatter {
+namespace {
+
+constexpr int kTag = 7311;
+constexpr std::uint64_t kChunk = std::uint64_t{1} << 30;  // MPI counts are int
+
+/// The partition of the whole model every part is cut from.
+struct Partition {
+  std::vector<int> granule_rank, block_color;
+  NodeRanks touch;
+  std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
+  Index bc_nodes = 0;
+};
+
+Partition partition(const Model& whole, int ranks) {
+  Partition p;
+  const Mesh& mesh = whole.mesh;
+  p.granule_rank = partition_granules(mesh, ElementForces::kGranule, ranks);
+  p.block_color = block_colors(mesh);
+  std::vector<int> elem_part(mesh.num_elements());
+  for (Index e = 0; e < mesh.num_elements(); ++e) elem_part[e] = p.granule_rank[e / ElementForces::kGranule];
+  p.touch = touching_ranks(mesh, elem_part);
+  p.bc_index.assign(mesh.num_nodes(), -1);
+  for (Index n = 0; n < mesh.num_nodes(); ++n)
+    if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;
+  return p;
+}
+
+/// Rank r's part of `whole` (without scene and materials).
+Model cut(const Model& whole, const Partition& p, int r) {
+  const Mesh& wm = whole.mesh;
+  const int k = wm.nodes_per_element();
+  Model m;
+  Model::Part& part = m.part;
+  auto touches = [&](Index n) {
+    const std::span<const int> rs = p.touch.of(n);
+    return std::binary_search(rs.begin(), rs.end(), r);
+  };
+  std::vector<Index> local(wm.num_nodes(), -1);
+  for (Index e = 0; e < wm.num_elements(); ++e) {
+    bool held = false;
+    for (int a = 0; a < k && !held; ++a) held = touches(wm.element(e)[a]);
+    if (!held) continue;
+    part.element_index.push_back(e);
+    for (int a = 0; a < k; ++a) local[wm.element(e)[a]] = 0;
+  }
+  for (Index n = 0; n < wm.num_nodes(); ++n)
+    if (local[n] == 0) {
+      local[n] = static_cast<Index>(part.node_index.size());
+      part.node_index.push_back(n);
+    }
+
+  Mesh& mesh = m.mesh;
+  mesh.order = wm.order;
+  mesh.revision = wm.revision;
+  for (Index n : part.node_index) {
+    mesh.reference.push_back(wm.reference[n]);
+    mesh.node_gid.push_back(wm.node_gid[n]);
+    mesh.node_body.push_back(wm.node_body[n]);
+    m.mass.push_back(whole.mass[n]);
+    m.bc_mask.push_back(whole.bc_mask[n]);
+    m.bc_velocity.push_back(whole.bc_velocity[n]);
+    m.initial_velocity.push_back(whole.initial_velocity[n]);
+    if (whole.bc_mask[n]) part.bc_index.push_back(p.bc_index[n]);
+    part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
+    for (int q : p.touch.of(n)) part.node_ranks.push_back(q);
+  }
+  part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
+  Index last_block = -1;
+  for (Index e : part.element_index) {
+    for (int a = 0; a < k; ++a) {
+      mesh.conn.push_back(local[wm.element(e)[a]]);
+      m.element_node_mass.push_back(whole.element_node_mass[static_cast<size_t>(e) * k + a]);
+    }
+    mesh.elem_gid.push_back(wm.elem_gid[e]);
+    mesh.elem_body.push_back(wm.elem_body[e]);
+    mesh.elem_material.push_back(wm.elem_material[e]);
+    m.element_volume.push_back(whole.element_volume[e]);
+    if (wm.order == 1) m.tet4_Dm_inv.push_back(whole.tet4_Dm_inv[e]);
+    else m.tet10_ref.push_back(whole.tet10_ref[e]);
+    if (e / ElementForces::kBlock != last_block) {
+      last_block = e / ElementForces::kBlock;
+      part.block_color.push_back(p.block_color[last_block]);
+    }
+  }
+  mesh.build_node_elements();
+  m.body_mass = whole.body_mass;
+  m.body_volume = whole.body_volume;
+  part.granule_rank = p.granule_rank;
+  part.whole_elements = wm.num_elements();
+  part.whole_nodes = wm.num_nodes();
+  part.whole_bc_nodes = p.bc_nodes;
+  part.fingerprint = model_fingerprint(whole);
+  return m;
+}
+
+void send_bytes(const void* data, std::uint64_t bytes, int dest, MPI_Comm comm) {
+  for (std::uint64_t at = 0; at < bytes; at += kChunk)
+    MPI_Send(static_cast<const char*>(data) + at, static_cast<int>(std::min(kChunk, bytes - at)), MPI_BYTE, dest,
+             kTag, comm);
+}
+
+void receive_bytes(void* data, std::uint64_t bytes, MPI_Comm comm) {
+  for (std::uint64_t at = 0; at < bytes; at += kChunk)
+    MPI_Recv(static_cast<char*>(data) + at, static_cast<int>(std::min(kChunk, bytes - at)), MPI_BYTE, 0, kTag,
+             comm, MPI_STATUS_IGNORE);
+}
+
+void send_part(const Model& m, int dest, MPI_Comm comm) {
+  const std::uint64_t head[6] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
+                                 static_cast<std::uint64_t>(m.part.whole_elements),
+                                 static_cast<std::uint64_t>(m.part.whole_nodes),
+                                 static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint};
+  send_bytes(head, sizeof head, dest, comm);
+  for_each_array(m, [&](const auto& v) {
+    const std::uint64_t n = v.size();
+    send_bytes(&n, sizeof n, dest, comm);
+    send_bytes(v.data(), n * sizeof(v[0]), dest, comm);
+  });
+}
+
+void receive_part(Model& m, MPI_Comm comm) {
+  std::uint64_t head[6];
+  receive_bytes(head, sizeof head, comm);
+  m.mesh.order = static_cast<int>(head[0]);
+  m.mesh.revision = head[1];
+  m.part.whole_elements = static_cast<Index>(head[2]);
+  m.part.whole_nodes = static_cast<Index>(head[3]);
+  m.part.whole_bc_nodes = static_cast<Index>(head[4]);
+  m.part.fingerprint = head[5];
+  for_each_array(m, [&](auto& v) {
+    std::uint64_t n = 0;
+    receive_bytes(&n, sizeof n, comm);
+    v.resize(n);
+    receive_bytes(v.data(), n * sizeof(v[0]), comm);
+  });
+}
+
+}  // namespace
+
+void distribute_parts(Model& model, MPI_Comm comm) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  if (rank != 0) return receive_part(model, comm);
+  const Partition p = partition(model, ranks);
+  for (int r = 1; r < ranks; ++r) send_part(cut(model, p, r), r, comm);
+  Model mine = cut(model, p, 0);
+  mine.scene = std::move(model.scene);
+  mine.materials = std::move(model.materials);
+  model = std::move(mine);
+}
+
+}  // namespace shatter
