@@ -24,11 +24,15 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   options_.max_sweeps = spec.max_sweeps;
   margin_fraction_ = spec.search_margin;
   options_.placement = spec.placement;
-  rebuild(model.mesh);
+  // A part of the model brings the whole model's surface.
+  if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
+  else rebuild(model.mesh);
 }
 
-void ContactStage::rebuild(const Mesh& mesh) {
-  surface_ = build_contact_surface(mesh);
+void ContactStage::rebuild(const Mesh& mesh) { set_surface(build_contact_surface(mesh), mesh); }
+
+void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
+  surface_ = std::move(surface);
   vertex_triangles_ = vertex_triangles(surface_);
   std::vector<double> lengths;
   lengths.reserve(surface_.edges.size());

@@ -90,6 +90,9 @@ class ContactStage {
   double margin() const { return margin_; }
 
  private:
+  /// The surface (of `mesh`'s nodes) and what depends on it: the search
+  /// margin, the candidates, the RCB order.
+  void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   void search(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
   /// This rank's new candidates (mine_); a new RCB partition when needed (the rule in contact_stage.cpp).

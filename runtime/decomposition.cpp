@@ -84,20 +84,24 @@ void Decomposition::rebuild_nodes() {
   home_granule_.resize(nn);
   // (A ghost-only node of a part may not hold its whole star here, but no
   // element of it is owned here, so neither is the granule computed.)
+  // A part's contact-surface nodes outside its elements have no star here,
+  // and no home granule (-1: they are never owned here).
   for (Index n = 0; n < nn; ++n)
-    home_granule_[n] = model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
+    home_granule_[n] = mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
+                           ? -1
+                           : model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
   {
     std::vector<Index> slot(num_granules(), -1);
     for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
     home_offsets_.assign(owned_granules_.size() + 1, 0);
     for (Index n = 0; n < nn; ++n)
-      if (slot[home_granule_[n]] >= 0) ++home_offsets_[slot[home_granule_[n]] + 1];
+      if (home_granule_[n] >= 0 && slot[home_granule_[n]] >= 0) ++home_offsets_[slot[home_granule_[n]] + 1];
     for (size_t k = 0; k < owned_granules_.size(); ++k) home_offsets_[k + 1] += home_offsets_[k];
     home_nodes_.resize(home_offsets_.back());
     owned_nodes_.clear();
     std::vector<Index> fill(home_offsets_.begin(), home_offsets_.end() - 1);
     for (Index n = 0; n < nn; ++n)
-      if (slot[home_granule_[n]] >= 0) {
+      if (home_granule_[n] >= 0 && slot[home_granule_[n]] >= 0) {
         home_nodes_[fill[slot[home_granule_[n]]]++] = n;
         owned_nodes_.push_back(n);
       }

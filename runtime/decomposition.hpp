@@ -3,7 +3,7 @@
 // docs/parallel.md "The decomposed time loop").
 //
 // A rank holds either its part of the model (owned elements and ghost
-// layer, Model::Part: scenes without contact and fracture) or the whole
+// layer, Model::Part: scenes without fracture) or the whole
 // model; either way the work is divided as follows, on the part's local
 // ids, the granules and blocks being those of the whole model. The elements are cut into granules of ElementForces::kGranule
 // consecutive elements (consecutive in the locality order, so a granule is a
@@ -97,7 +97,7 @@ class Decomposition {
   /// The home nodes of all owned granules, ascending.
   std::span<const Index> owned_nodes() const { return owned_nodes_; }
   /// Whether this rank adds node n's terms to global sums (it owns n's home granule).
-  bool owns_node(Index n) const { return owns_granule(home_granule_[n]); }
+  bool owns_node(Index n) const { return home_granule_[n] >= 0 && owns_granule(home_granule_[n]); }
   /// Elements of the owned granules, ascending.
   std::span<const Index> owned_element_ids() const { return owned_element_ids_; }
   /// Whether element e is owned here.

@@ -80,8 +80,8 @@ Model build_model(const Scene& scene, MPI_Comm comm) {
   if (ranks == 1) {
     m.mesh = mesh_bodies(scene);
     complete_model(m);
-  } else if (scene.contact || scene.fracture_enabled()) {
-    // Contact and fracture still need the whole model on every rank (docs/parallel.md "Limits").
+  } else if (scene.fracture_enabled()) {
+    // Fracture still needs the whole model on every rank (docs/parallel.md "Limits").
     on_root(comm, [&] { m.mesh = mesh_bodies(scene); });
     broadcast_mesh(m.mesh, 0, comm);
     complete_model(m);

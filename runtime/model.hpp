@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "contact/surface.hpp"
 #include "kernels/neo_hookean.hpp"
 #include "kernels/tet10.hpp"
 #include "mesh/mesh.hpp"
@@ -35,7 +36,8 @@ struct Model {
 
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
   /// its owned elements and their ghost layer, ascending in the whole
-  /// model's order, and the nodes they use. Empty `element_index`: this
+  /// model's order, and the nodes they use (with contact, and the contact
+  /// surface's nodes). Empty `element_index`: this
   /// model is the whole one (one rank, or a scene every rank holds whole).
   struct Part {
     std::vector<Index> element_index;  ///< per element: its index in the whole model
@@ -45,6 +47,9 @@ struct Model {
     std::vector<Index> node_rank_offsets;
     std::vector<int> node_ranks;       ///< CSR per node: the ranks whose owned elements use it, ascending
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
+    /// Contact scenes: the whole model's contact surface (build_contact_surface),
+    /// in local node ids; its nodes are held here, in elements or not.
+    std::vector<SurfaceTriangle> surface;
     Index whole_elements = 0, whole_nodes = 0, whole_bc_nodes = 0;
     std::uint64_t fingerprint = 0;     ///< model_fingerprint() of the whole model
   } part;
@@ -65,12 +70,12 @@ void for_each_array(M& m, F f) {
   f(m.tet4_Dm_inv), f(m.tet10_ref), f(m.element_volume), f(m.element_node_mass), f(m.mass), f(m.bc_mask);
   f(m.bc_velocity), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
-  f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index);
+  f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index), f(m.part.surface);
 }
 
 /// Mesh every body, check the meshes, and compute every constant of the model.
 /// On several ranks of `comm` (collective) rank 0 meshes and computes the
-/// whole model. A scene without contact and fracture is then cut: rank 0
+/// whole model. A scene without fracture is then cut: rank 0
 /// partitions it (METIS granules) and sends every rank its part (owned
 /// elements and ghost layer, Model::Part), keeping its own; otherwise every
 /// rank receives the mesh and computes the whole model. Throws InputError

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "kernels/error.hpp"
+#include "contact/surface.hpp"
 #include "mesh/partition.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/element_forces.hpp"
@@ -21,6 +22,7 @@ struct Partition {
   NodeRanks touch;
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
+  ContactSurface surface;       ///< contact scenes: of the whole model
 };
 
 Partition partition(const Model& whole, int ranks) {
@@ -34,6 +36,7 @@ Partition partition(const Model& whole, int ranks) {
   p.bc_index.assign(mesh.num_nodes(), -1);
   for (Index n = 0; n < mesh.num_nodes(); ++n)
     if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;
+  if (whole.scene.contact) p.surface = build_contact_surface(mesh);
   return p;
 }
 
@@ -55,6 +58,7 @@ Model cut(const Model& whole, const Partition& p, int r) {
     part.element_index.push_back(e);
     for (int a = 0; a < k; ++a) local[wm.element(e)[a]] = 0;
   }
+  for (Index n : p.surface.vertices) local[n] = 0;
   for (Index n = 0; n < wm.num_nodes(); ++n)
     if (local[n] == 0) {
       local[n] = static_cast<Index>(part.node_index.size());
@@ -95,6 +99,10 @@ Model cut(const Model& whole, const Partition& p, int r) {
     }
   }
   mesh.build_node_elements();
+  for (size_t t = 0; t < p.surface.triangles.size(); ++t) {
+    const auto& [a, b, c] = p.surface.triangles[t];
+    part.surface.push_back({{local[a], local[b], local[c]}, p.surface.body[t]});
+  }
   m.body_mass = whole.body_mass;
   m.body_volume = whole.body_volume;
   part.granule_rank = p.granule_rank;

@@ -4,7 +4,9 @@
 // sends every rank its owned elements, the ghost layer (every element with a
 // node an owned element uses) and the nodes they use, with their indices in
 // the whole model, the whole model's block colors, the granule owners and
-// the ranks touching each node (Model::Part).
+// the ranks touching each node (Model::Part). With contact, the part also
+// holds the whole contact surface (its state is shared by every rank until
+// the contact surface is distributed, issue 16).
 #include <mpi.h>
 
 #include "runtime/model.hpp"

@@ -205,7 +205,9 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   long owned = d.owned_elements(), total = 0;
   MPI_Allreduce(&owned, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(total, whole.mesh.num_elements());
-  if (ranks > 1) EXPECT_LT(part.mesh.num_elements(), whole.mesh.num_elements());
+  if (ranks > 1) {
+    EXPECT_LT(part.mesh.num_elements(), whole.mesh.num_elements());
+  }
 
   // The ghost-only positions from their owners, then the forces: the whole model's.
   std::vector<Vec3> x(part.mesh.num_nodes(), Vec3::Constant(std::nan(""))), f(x.size());
