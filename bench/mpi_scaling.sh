@@ -14,6 +14,10 @@
 #       one box of ELEMENTS tets (default 2000000) on R = 1, 2, 4, ... MAX_RANKS
 #       (default 8) ranks, 20 steps: each rank's peak memory and the bytes of
 #       the arrays a rank holds in the loop (summary.json), against one rank.
+#   bench/mpi_scaling.sh BUILD capacity [ELEMENTS] [RANKS]
+#       the two boxes with contact, ELEMENTS tets in all (default 4000000) on
+#       RANKS ranks (default 16, oversubscribed), 50 steps of 2e-6 s (they meet
+#       after 5e-5 s): each rank's peak memory, their sum, and the contacts.
 #
 # Results: bench/results/mpi_scaling_<mode>.csv
 set -euo pipefail
@@ -56,6 +60,12 @@ YAML
 # Element size for a target count: 9798 tets at h = 0.1, count ~ h^-2.93 (measured).
 size_for() { python3 -c "print(f'{0.1 * (9798 / $1) ** (1 / 2.93):.5f}')"; }
 key() { grep -o "\"$2\": [-0-9.e+]*" "$1/summary.json" | awk '{print $2}'; }
+# peak_memory_bytes_per_rank of a run as MB: rank 0's, the largest other's, the sum.
+peaks() {
+  local p
+  p=$(grep -o '"peak_memory_bytes_per_rank": \[[^]]*\]' "$1/summary.json" | sed 's/.*\[//; s/\]//' | tr ',' '\n')
+  echo "$(echo "$p" | awk 'NR == 1 {printf "%.0f", $1 / 1e6}'),$(echo "$p" | awk 'NR > 1 && $1 > m {m = $1} END {printf "%.0f", m / 1e6}'),$(echo "$p" | awk '{s += $1} END {printf "%.0f", s / 1e6}')"
+}
 
 if [ "$mode" = strong ]; then
   elements=${3:-500000}
@@ -85,6 +95,21 @@ if [ "$mode" = strong ]; then
       awk '{w[NR] = $1; d[NR] = $2} END {m = int((NR + 1) / 2); print w[m], d[m], w[1], w[NR]}')"
     echo "$1,$2,$(key "$dir" elements),$(key "$dir" steps),$median,$lo,$hi,$(key "$dir" element_loop_time),$(key "$dir" contact_search_time),$(key "$dir" contact_dcr_time),$(key "$dir" communication_time)" | tee -a "$out"
   done
+elif [ "$mode" = capacity ]; then
+  elements=${3:-4000000}
+  ranks=${4:-16}
+  h=$(size_for $((elements / 2)))
+  out="$here/results/mpi_scaling_capacity.csv"
+  echo "ranks,elements,steps,max_contacts,wall_s,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB" > "$out"
+  dir="$work/capacity"
+  start=$(date +%s)
+  "${mpi[@]}" --bind-to none -n "$ranks" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet \
+    --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h" \
+    --set time.dt=2.0e-6 --set time.end=1.0e-4 --set output.history_every=1
+  wall=$(( $(date +%s) - start ))
+  col=$(head -1 "$dir/history.csv" | tr ',' '\n' | grep -n '^contacts$' | cut -d: -f1)
+  contacts=$(tail -n +2 "$dir/history.csv" | cut -d, -f"$col" | sort -n | tail -1)
+  echo "$ranks,$(key "$dir" elements),$(key "$dir" steps),$contacts,$wall,$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
 elif [ "$mode" = memory ]; then
   elements=${3:-2000000}
   max_ranks=${4:-8}
@@ -98,8 +123,7 @@ elif [ "$mode" = memory ]; then
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet \
       --set "contact=null" --set "bodies=[{name: box, material: seed, mesh: {shape: box, size: [1.0, 1.0, 1.0], element_size: $h}, initial_velocity: [20.0, 0.0, 0.0]}]" \
       --set time.end=1.0e-9 --set time.dt=5.0e-11
-    peaks=$(grep -o '"peak_memory_bytes_per_rank": \[[^]]*\]' "$dir/summary.json" | sed 's/.*\[//; s/\]//')
-    echo "$r,$(key "$dir" elements),$(echo "$peaks" | tr ',' '\n' | awk 'NR == 1 {printf "%.0f", $1 / 1e6}'),$(echo "$peaks" | tr ',' '\n' | awk 'NR > 1 && $1 > m {m = $1} END {printf "%.0f", m / 1e6}'),$(echo "$peaks" | tr ',' '\n' | awk '{s += $1} END {printf "%.0f", s / 1e6}'),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
+    echo "$r,$(key "$dir" elements),$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
     r=$((r * 2))
   done
 else

@@ -69,7 +69,7 @@ void check_ranks(const Model& model, int ranks) {
   const Index ne = model.whole_elements(), ng = (ne + ElementForces::kGranule - 1) / ElementForces::kGranule;
   if (ranks > ng)
     throw InputError(model.scene.file + ": the mesh has " + std::to_string(ne) + " elements, " +
-                     std::to_string(ng) + " granules of " + std::to_string(ElementForces::kGranule) +
+                     std::to_string(ng) + (ng == 1 ? " granule of " : " granules of ") + std::to_string(ElementForces::kGranule) +
                      "; it cannot be shared by " + std::to_string(ranks) + " MPI ranks (use at most " +
                      std::to_string(ng) + ")");
 }

@@ -11,7 +11,9 @@
 #   - every rank finds the stable step collapsed (a face driven at 300 m/s
 #     crushes the box): exit 1, one error line, the same as on one rank (the
 #     element with the smallest step over all ranks), a checkpoint;
-#   - bad input on every rank: exit 2, one error line.
+#   - bad input on every rank: exit 2, one error line;
+#   - a mesh too small for the ranks (fewer granules of 256 elements than
+#     ranks): exit 2, one error line that says how many ranks it can take.
 # A hang is caught by `timeout` (and ctest's TIMEOUT).
 # usage: failures.sh SHATTER FAIL_ALONE MPIEXEC WORKDIR
 set -uo pipefail
@@ -73,4 +75,6 @@ timeout -k 10 100 "$shatter" run "$work/box.yaml" --threads 1 --quiet --out "$wo
   { echo "FAIL collapse: not the message of one rank, or no checkpoint:"; cat "$work/collapse1.log"; fail=1; }
 
 run bad_input 2 "time.end: expected a positive number, got 'soon'" "${mpi[@]}" --out "$work/bad" --set time.end=soon
+run too_many_ranks 2 "cannot be shared by 2 MPI ranks (use at most 1)" "${mpi[@]}" --out "$work/small" \
+  --set bodies[0].mesh.element_size=0.005
 exit $fail
