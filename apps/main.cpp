@@ -20,6 +20,7 @@
 
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
+#include "runtime/decomposition.hpp"
 #include "runtime/failure.hpp"
 #include "runtime/disk_reserve.hpp"
 #include "runtime/model.hpp"
@@ -34,29 +35,44 @@ using namespace shatter;
 
 namespace {
 
+/// The model summary of `shatter check`, printed by rank 0; on several ranks
+/// each holds its part, and the counts are summed over the owned nodes and
+/// elements (collective).
 void print_check(const Model& model, const Simulation& sim) {
   const Scene& s = model.scene;
   const Mesh& mesh = model.mesh;
+  const Decomposition& d = sim.decomposition();
+  const size_t nb = s.bodies.size();
+  std::vector<long> count(2 * nb, 0);  // per body: nodes, elements
+  for (Index i : d.owned_nodes()) ++count[2 * mesh.node_body[i]];
+  for (Index e : d.owned_element_ids()) ++count[2 * mesh.elem_body[e] + 1];
+  count = d.sum(count);
+  MeshScaledJacobian worst;
+  if (mesh.order == 2) {
+    worst = min_scaled_jacobian(mesh);
+    double value = worst.value, gid = static_cast<double>(worst.element);
+    const int rank = d.rank_of_min(value);
+    d.broadcast({&gid, 1}, rank);
+    worst = {d.min(value), static_cast<GlobalId>(gid)};
+  }
+  const double dt = s.fixed_dt ? *s.fixed_dt : sim.stable_dt();
+  // The model's arrays plus the solver's five nodal vectors and work arrays, the largest rank's.
+  const long memory = d.max(static_cast<long>(model_bytes(model) + double(mesh.num_nodes()) * (5 * sizeof(Vec3) + sizeof(double))));
+  if (d.rank() != 0) return;
   std::printf("scene %s (%s)\n", s.name.c_str(), s.file.c_str());
   std::printf("%-12s %-12s %10s %10s %14s %14s\n", "body", "material", "nodes", "elements", "mass [kg]", "volume [m^3]");
-  for (size_t b = 0; b < s.bodies.size(); ++b) {
-    long nodes = 0, elems = 0;
-    for (Index i = 0; i < mesh.num_nodes(); ++i) nodes += mesh.node_body[i] == int(b);
-    for (Index e = 0; e < mesh.num_elements(); ++e) elems += mesh.elem_body[e] == int(b);
+  for (size_t b = 0; b < nb; ++b)
     std::printf("%-12s %-12s %10ld %10ld %14.6e %14.6e\n", s.bodies[b].name.c_str(),
-                s.materials[s.bodies[b].material].name.c_str(), nodes, elems, model.body_mass[b], model.body_volume[b]);
-  }
+                s.materials[s.bodies[b].material].name.c_str(), count[2 * b], count[2 * b + 1], model.body_mass[b],
+                model.body_volume[b]);
   double mass = 0;
   for (double m : model.body_mass) mass += m;
-  std::printf("total: %d nodes, %d elements (TET%d), mass %.6e kg\n", mesh.num_nodes(), mesh.num_elements(),
+  std::printf("total: %d nodes, %d elements (TET%d), mass %.6e kg\n", model.whole_nodes(), model.whole_elements(),
               mesh.nodes_per_element(), mass);
-  if (mesh.order == 2) {
-    const MeshScaledJacobian worst = min_scaled_jacobian(mesh);
+  if (mesh.order == 2)
     std::printf("TET10 minimum scaled Jacobian %.4f (element %lld; det J / (6 x volume) at the quadrature points, 1 "
                 "for straight-sided elements, valid above 0)\n",
                 worst.value, static_cast<long long>(worst.element));
-  }
-  const double dt = s.fixed_dt ? *s.fixed_dt : sim.stable_dt();
   std::printf("stable dt %.4e s (safety %.2f)%s; dt used %.4e s\n", sim.stable_dt() / s.safety, s.safety,
               s.fixed_dt && *s.fixed_dt > sim.stable_dt() ? "  WARNING: time.dt is above it" : "", dt);
   const double steps = std::ceil(s.end_time / dt);
@@ -64,9 +80,7 @@ void print_check(const Model& model, const Simulation& sim) {
   std::printf("contact: %s; fracture: %s; gravity: [%g, %g, %g]; boundary conditions: %zu\n",
               s.contact ? "on" : "off", s.fracture_enabled() ? "on" : "off", s.gravity.x(), s.gravity.y(),
               s.gravity.z(), s.boundary_conditions.size());
-  // The model arrays plus the solver's five nodal vectors and work arrays.
-  const double state = double(mesh.num_nodes()) * (5 * sizeof(Vec3) + sizeof(double));
-  std::printf("memory: about %.1f MB\n", (model_bytes(model) + state) / 1e6);
+  std::printf("memory: about %.1f MB%s\n", memory / 1e6, d.distributed() ? " on the largest rank" : "");
 }
 
 /// Run scripts/plot.py of the source tree (SHATTER_SOURCE_DIR) with the Python

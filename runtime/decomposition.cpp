@@ -285,6 +285,21 @@ double Decomposition::min(double value) const {
   return value;
 }
 
+int Decomposition::rank_of_min(double value) const {
+  struct {
+    double value;
+    int rank;
+  } least{value, rank_};
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &least, 1, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+  return least.rank;
+}
+
+std::vector<long> Decomposition::sum(std::vector<long> values) const {
+  if (size_ > 1)
+    MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_LONG, MPI_SUM, comm_);
+  return values;
+}
+
 int Decomposition::max(int value) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_INT, MPI_MAX, comm_);
   return value;

@@ -145,6 +145,10 @@ class Decomposition {
   std::vector<Index> allgather(std::span<const Index> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
+  /// The smallest rank holding the global minimum of `value`.
+  int rank_of_min(double value) const;
+  /// Element-wise sums over the ranks, on every rank.
+  std::vector<long> sum(std::vector<long> values) const;
   /// Global maximum of an int.
   int max(int value) const;
   /// Global maximum of a long.

@@ -165,6 +165,8 @@ void distribute_parts(Model& model, MPI_Comm comm) {
   const Partition p = partition(model, ranks);
   for (int r = 1; r < ranks; ++r) send_part(cut(model, p, r), r, comm);
   Model mine = cut(model, p, 0);
+  // (cut() grows its arrays one push at a time; the received ones are exact.)
+  for_each_array(mine, [](auto& v) { v.shrink_to_fit(); });
   mine.scene = std::move(model.scene);
   mine.materials = std::move(model.materials);
   model = std::move(mine);
