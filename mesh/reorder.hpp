@@ -28,8 +28,7 @@ enum class GlobalIdPolicy {
   keep,      ///< ids move with their entities (Gmsh tags stay attached)
   renumber,  ///< the same set of ids, handed out in ascending order along the
              ///< new local order: ascending gid == new order, so anything that
-             ///< sorts by gid (extract_subdomain's canonical order) inherits
-             ///< the locality on every rank
+             ///< sorts by gid inherits the locality on every rank
 };
 
 /// Reorder elements along the Morton curve of their reference centroids
