@@ -1,0 +1,176 @@
+#include "mesh/shell_mesh.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "kernels/error.hpp"
+
+namespace shatter {
+namespace {
+
+using EdgeKey = std::uint64_t;
+
+EdgeKey edge_key(Index p, Index q) {
+  return (static_cast<EdgeKey>(static_cast<std::uint32_t>(p)) << 32) | static_cast<std::uint32_t>(q);
+}
+
+std::string vertices_named(Index p, Index q) {
+  return "vertices " + std::to_string(p) + " and " + std::to_string(q);
+}
+
+/// Orient the triangles consistently, component by component (breadth first
+/// from the component's first triangle), and a closed component outward
+/// (positive enclosed volume). `edge_triangles` holds each undirected edge's
+/// one or two triangles.
+void orient(std::vector<std::array<Index, 3>>& tris, const std::vector<Vec3>& x,
+            const std::unordered_map<EdgeKey, std::vector<Index>>& edge_triangles, const std::string& where) {
+  const Index nt = static_cast<Index>(tris.size());
+  std::vector<Index> component(nt, -1);
+  auto has_directed = [&](Index t, Index p, Index q) {
+    for (int k = 0; k < 3; ++k)
+      if (tris[t][k] == p && tris[t][(k + 1) % 3] == q) return true;
+    return false;
+  };
+  Index num_components = 0;
+  std::vector<Index> queue;
+  for (Index seed = 0; seed < nt; ++seed) {
+    if (component[seed] >= 0) continue;
+    const Index c = num_components++;
+    component[seed] = c;
+    queue.assign(1, seed);
+    bool closed = true;
+    double six_volume = 0;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const Index t = queue[head];
+      const auto [a, b, d] = tris[t];
+      six_volume += x[a].dot(x[b].cross(x[d]));
+      for (int k = 0; k < 3; ++k) {
+        const Index p = tris[t][k], q = tris[t][(k + 1) % 3];
+        const auto& across = edge_triangles.at(edge_key(std::min(p, q), std::max(p, q)));
+        if (across.size() == 1) closed = false;
+        for (Index u : across) {
+          if (u == t) continue;
+          if (component[u] < 0) {
+            if (has_directed(u, p, q)) std::swap(tris[u][1], tris[u][2]);
+            component[u] = c;
+            queue.push_back(u);
+          } else if (has_directed(u, p, q)) {
+            throw InputError(where + ": the surface is not orientable (triangles " + std::to_string(t) + " and " +
+                             std::to_string(u) + " at " + vertices_named(p, q) + ")");
+          }
+        }
+      }
+    }
+    if (closed && six_volume < 0)
+      for (Index t : queue) std::swap(tris[t][1], tris[t][2]);
+  }
+}
+
+}  // namespace
+
+ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Index, 3>> triangles,
+                           const std::string& where) {
+  ShellMesh m;
+  m.reference = std::move(points);
+  m.triangles = std::move(triangles);
+  const Index n = m.num_vertices(), nt = m.num_triangles();
+  std::vector<Index> incident(n, 0);
+  std::unordered_map<EdgeKey, std::vector<Index>> edge_triangles;
+  for (Index t = 0; t < nt; ++t) {
+    const auto& c = m.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      if (c[k] < 0 || c[k] >= n)
+        throw InputError(where + ": triangle " + std::to_string(t) + " names vertex " + std::to_string(c[k]) +
+                         " of " + std::to_string(n));
+      if (c[k] == c[(k + 1) % 3])
+        throw InputError(where + ": triangle " + std::to_string(t) + " repeats vertex " + std::to_string(c[k]));
+    }
+    for (int k = 0; k < 3; ++k) {
+      ++incident[c[k]];
+      const Index p = c[k], q = c[(k + 1) % 3];
+      auto& tris = edge_triangles[edge_key(std::min(p, q), std::max(p, q))];
+      tris.push_back(t);
+      if (tris.size() > 2) throw InputError(where + ": the edge of " + vertices_named(p, q) + " has 3 or more triangles");
+    }
+  }
+  for (Index v = 0; v < n; ++v)
+    if (incident[v] == 0) throw InputError(where + ": vertex " + std::to_string(v) + " is in no triangle");
+  orient(m.triangles, m.reference, edge_triangles, where);
+
+  // opposite[(p, q)] = r for every oriented triangle (p, q, r)
+  std::unordered_map<EdgeKey, Index> opposite;
+  opposite.reserve(3 * static_cast<std::size_t>(nt));
+  for (const auto& c : m.triangles)
+    for (int k = 0; k < 3; ++k) opposite[edge_key(c[k], c[(k + 1) % 3])] = c[(k + 2) % 3];
+  auto opp = [&](Index p, Index q) {
+    const auto it = opposite.find(edge_key(p, q));
+    return it == opposite.end() ? Index{-1} : it->second;
+  };
+
+  m.valence.assign(n, 0);
+  m.on_boundary.assign(n, 0);
+  for (const auto& [key, tris] : edge_triangles) {
+    const Index p = static_cast<Index>(key >> 32), q = static_cast<Index>(key & 0xffffffffu);
+    ++m.valence[p];
+    ++m.valence[q];
+    if (tris.size() == 1) m.on_boundary[p] = m.on_boundary[q] = 1;
+  }
+  // One fan per vertex: walking the triangles around p from one of its
+  // neighbours (from the clockwise end of the fan on a boundary) must visit
+  // all of them, and meet as many edges as p has.
+  std::vector<Index> some_neighbour(n, -1);
+  for (const auto& c : m.triangles)
+    for (int k = 0; k < 3; ++k) some_neighbour[c[k]] = c[(k + 1) % 3];
+  for (Index p = 0; p < n; ++p) {
+    Index q = some_neighbour[p], walked = 0;
+    if (m.on_boundary[p])
+      for (Index s = opp(q, p); s >= 0 && walked <= incident[p]; s = opp(q, p), ++walked) q = s;
+    walked = 0;
+    for (Index r = opp(p, q); r >= 0 && walked <= incident[p]; r = opp(p, r)) {
+      ++walked;
+      if (r == q) break;  // back at the start: an interior vertex
+    }
+    if (walked != incident[p] || m.valence[p] != incident[p] + m.on_boundary[p])
+      throw InputError(where + ": the triangles at vertex " + std::to_string(p) + " do not form one fan");
+  }
+
+  // The ring of interior vertex p counter-clockwise from its neighbour q.
+  auto ring = [&](Index p, Index q) {
+    std::vector<Index> r(1, q);
+    for (Index s = opp(p, q); s != q; s = opp(p, s)) r.push_back(s);
+    return r;
+  };
+  m.patch_kind.resize(nt);
+  m.patch_offsets.assign(1, 0);
+  for (Index t = 0; t < nt; ++t) {
+    auto& c = m.triangles[t];
+    int irregular = 0, first_irregular = 0;
+    bool boundary = false;
+    for (int k = 0; k < 3; ++k) {
+      boundary = boundary || m.on_boundary[c[k]];
+      if (m.valence[c[k]] != 6 && irregular++ == 0) first_irregular = k;
+    }
+    if (boundary) {
+      m.patch_kind[t] = ShellPatchKind::boundary;
+    } else if (irregular > 1) {
+      m.patch_kind[t] = ShellPatchKind::several_extraordinary;
+    } else {
+      std::rotate(c.begin(), c.begin() + first_irregular, c.end());
+      const auto ra = ring(c[0], c[1]), rb = ring(c[1], c[2]), rc = ring(c[2], c[0]);
+      if (irregular == 0) {
+        m.patch_kind[t] = ShellPatchKind::regular;
+        m.patch.insert(m.patch.end(),
+                       {ra[4], ra[3], ra[5], c[0], ra[2], rb[3], c[1], c[2], rc[4], rb[4], rb[5], rc[3]});
+      } else {
+        m.patch_kind[t] = ShellPatchKind::extraordinary;
+        m.patch.push_back(c[0]);
+        m.patch.insert(m.patch.end(), ra.begin(), ra.end());
+        m.patch.insert(m.patch.end(), {rb[3], rb[4], rb[5], rc[3], rc[4]});
+      }
+    }
+    m.patch_offsets.push_back(static_cast<Index>(m.patch.size()));
+  }
+  return m;
+}
+
+}  // namespace shatter

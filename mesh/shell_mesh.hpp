@@ -1,0 +1,69 @@
+#pragma once
+// Triangle control mesh of a shell's mid-surface and the Loop patch of each
+// triangle (Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072, sec. 4):
+// the control vertices whose shape functions are non-zero on the triangle,
+// i.e. the triangle's corners and their 1-rings.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+/// What the patch of a triangle is.
+///  regular:      three interior corners of valence 6; 12 control vertices in
+///                kernels/loop_basis.hpp order (Stam's 1..12 as 0..11);
+///  extraordinary: three interior corners, exactly one of valence N != 6;
+///                N + 6 control vertices in the order of ShellMesh::patch;
+///  several_extraordinary: more than one corner of valence != 6 (one Loop
+///                subdivision of the control mesh separates them); no patch;
+///  boundary:     a corner on the boundary; no patch (boundary rules or
+///                ghost vertices are not implemented: docs/shells.md).
+enum class ShellPatchKind : std::uint8_t { regular, extraordinary, several_extraordinary, boundary };
+
+/// A triangle control mesh, consistently oriented.
+///
+/// Layouts (n = vertices, t = triangles):
+///   reference[n]        reference position of the control vertex, m
+///   triangles[t]        corner vertices, counter-clockwise about the normal;
+///                       on a closed surface the normal points outward
+///   valence[n]          number of edges at the vertex
+///   on_boundary[n]      1 when the vertex is on a boundary edge
+///   patch_kind[t]
+///   patch_offsets[t+1], patch[...]: CSR triangle -> patch control vertices.
+///     regular: Stam's order (kernels/loop_basis.hpp), corners 4, 7, 8 =
+///       triangles[t][0], [1], [2].
+///     extraordinary, the corner of valence N first: triangles[t] is rotated
+///       so that it is corner 0, then
+///       0: that corner p; 1..N: its ring counter-clockwise from the next
+///       corner (1 = triangles[t][1], 2 = triangles[t][2], N = the vertex
+///       across the edge p-[1]); N+1..N+5: Stam's vertices 6, 10, 11, 12, 9
+///       (beyond corner [1], across the edge [1]-[2], beyond corner [2]).
+struct ShellMesh {
+  std::vector<Vec3> reference;
+  std::vector<std::array<Index, 3>> triangles;
+  std::vector<Index> valence;
+  std::vector<std::uint8_t> on_boundary;
+  std::vector<ShellPatchKind> patch_kind;
+  std::vector<Index> patch_offsets;
+  std::vector<Index> patch;
+
+  Index num_vertices() const { return static_cast<Index>(reference.size()); }
+  Index num_triangles() const { return static_cast<Index>(triangles.size()); }
+  const Index* patch_of(Index t) const { return patch.data() + patch_offsets[t]; }
+  Index patch_size(Index t) const { return patch_offsets[t + 1] - patch_offsets[t]; }
+};
+
+/// Build the control mesh from vertex positions and triangles (any
+/// orientation): the triangles are oriented consistently (by the first
+/// triangle, and outward when the surface is closed), then valences,
+/// boundary vertices and patches are found. InputError naming `where` for a
+/// corner index out of range, a triangle with a repeated corner, an edge of
+/// more than two triangles, a vertex whose triangles do not form one fan, a
+/// non-orientable surface or an unused vertex.
+ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Index, 3>> triangles,
+                           const std::string& where);
+
+}  // namespace shatter

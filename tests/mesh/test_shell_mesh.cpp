@@ -1,0 +1,206 @@
+// Shell control meshes: valences, boundaries, orientation and Loop patches
+// of a regular lattice and of Gmsh surfaces; bad triangle meshes refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "expect_close.hpp"
+#include "kernels/shell_kl.hpp"
+#include "mesh/mesh_test_helpers.hpp"
+#include "mesh/shell_gmsh.hpp"
+#include "mesh/shell_mesh.hpp"
+
+using namespace shatter;
+using shatter::test::input_error;
+
+namespace {
+const Vec3 kE1(1, 0, 0), kE2(0.5, std::sqrt(3.0) / 2, 0);
+
+/// An n x n parallelogram of the equilateral lattice (edge 1, in z = 0),
+/// vertex (i, j) = i e1 + j e2 at index i + n j; every other triangle of a
+/// checkerboard of cells given clockwise when `flip`.
+ShellMesh lattice(int n, bool flip = false) {
+  std::vector<Vec3> x;
+  std::vector<std::array<Index, 3>> tris;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.push_back(i * kE1 + j * kE2);
+  auto id = [n](int i, int j) { return Index(i + n * j); };
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const bool f = flip && (i + j) % 2 == 1;
+      tris.push_back(f ? std::array{id(i, j), id(i, j + 1), id(i + 1, j)} : std::array{id(i, j), id(i + 1, j), id(i, j + 1)});
+      tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return build_shell_mesh(std::move(x), std::move(tris), "lattice");
+}
+
+Vec3 normal(const ShellMesh& m, Index t) {
+  const auto& c = m.triangles[t];
+  return (m.reference[c[1]] - m.reference[c[0]]).cross(m.reference[c[2]] - m.reference[c[0]]);
+}
+}  // namespace
+
+TEST(ShellMesh, LatticePatchesFollowTheLoopBasisOrder) {
+  const int n = 8;
+  for (bool flip : {false, true}) {
+    const ShellMesh m = lattice(n, flip);
+    int regular = 0, boundary = 0;
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      const int i = v % n, j = v / n;
+      const bool edge = i == 0 || j == 0 || i == n - 1 || j == n - 1;
+      EXPECT_EQ(m.on_boundary[v], edge ? 1 : 0);
+      if (!edge) {
+        EXPECT_EQ(m.valence[v], 6);
+      }
+    }
+    for (Index t = 0; t < m.num_triangles(); ++t) {
+      EXPECT_GT(normal(m, t).z(), 0) << "triangle " << t;  // all oriented as the first
+      bool touches_edge = false;
+      for (Index v : m.triangles[t]) touches_edge = touches_edge || m.on_boundary[v];
+      if (touches_edge) {
+        EXPECT_EQ(m.patch_kind[t], ShellPatchKind::boundary);
+        EXPECT_EQ(m.patch_size(t), 0);
+        ++boundary;
+        continue;
+      }
+      ASSERT_EQ(m.patch_kind[t], ShellPatchKind::regular);
+      ASSERT_EQ(m.patch_size(t), 12);
+      ++regular;
+      const Index* p = m.patch_of(t);
+      EXPECT_EQ(p[3], m.triangles[t][0]);
+      EXPECT_EQ(p[6], m.triangles[t][1]);
+      EXPECT_EQ(p[7], m.triangles[t][2]);
+      const Vec3 x4 = m.reference[p[3]], e1 = m.reference[p[6]] - x4, e2 = m.reference[p[7]] - x4;
+      for (int a = 0; a < 12; ++a)
+        EXPECT_LT((m.reference[p[a]] - (x4 + kLoopRegularLattice[a][0] * e1 + kLoopRegularLattice[a][1] * e2)).norm(),
+                  1e-12)
+            << "triangle " << t << " patch vertex " << a;
+    }
+    EXPECT_EQ(regular, 2 * (n - 3) * (n - 3));
+    EXPECT_EQ(boundary, m.num_triangles() - regular);
+  }
+}
+
+TEST(ShellMesh, LumpedMassOfAnInteriorVertexIsItsShareOfTheArea) {
+  // Every triangle within two rings of the centre vertex is regular; its mass
+  // is rho t x the lattice area per vertex, sqrt(3)/2 (edge 1).
+  const int n = 9;
+  const ShellMesh m = lattice(n);
+  const Index centre = 4 + n * 4;
+  const double t = 0.01, rho = 1000;
+  const auto basis = loop_regular_basis_at_quadrature<3>();
+  double mass = 0;
+  for (Index e = 0; e < m.num_triangles(); ++e) {
+    if (m.patch_kind[e] != ShellPatchKind::regular) continue;
+    Eigen::Matrix<double, 3, 12> X;
+    for (int a = 0; a < 12; ++a) X.col(a) = m.reference[m.patch_of(e)[a]];
+    const auto ref = shell_reference<12, 3>(X, basis, t);
+    const auto me = shell_lumped_mass<12, 3>(basis, ref, t, rho);
+    for (int a = 0; a < 12; ++a)
+      if (m.patch_of(e)[a] == centre) mass += me[a];
+  }
+  EXPECT_CLOSE(mass, rho * t * std::sqrt(3.0) / 2, 1e-13, 0);
+}
+
+TEST(ShellMesh, GmshSphereIsClosedOutwardAndItsPatchesLieOnTheSphere) {
+  ShellShapeSpec s;
+  s.shape = "sphere";
+  s.radius = 0.12;
+  s.center = Vec3(0.1, -0.2, 0.3);
+  s.element_size = 0.02;
+  const ShellMesh m = mesh_shell_shape(s, "sphere");
+  // closed: V - E + F = 2, no boundary
+  Index edges = 0;
+  for (Index v = 0; v < m.num_vertices(); ++v) {
+    edges += m.valence[v];
+    EXPECT_EQ(m.on_boundary[v], 0);
+  }
+  EXPECT_EQ(m.num_vertices() - edges / 2 + m.num_triangles(), 2);
+  int counts[4] = {0, 0, 0, 0};
+  const auto basis = loop_regular_basis_at_quadrature<1>();
+  for (Index t = 0; t < m.num_triangles(); ++t) {
+    const auto& c = m.triangles[t];
+    const Vec3 centroid = (m.reference[c[0]] + m.reference[c[1]] + m.reference[c[2]]) / 3;
+    EXPECT_GT(normal(m, t).dot(centroid - s.center), 0) << "triangle " << t;  // outward
+    ++counts[static_cast<int>(m.patch_kind[t])];
+    if (m.patch_kind[t] == ShellPatchKind::extraordinary) {
+      EXPECT_EQ(m.patch_size(t), m.valence[c[0]] + 6);
+      EXPECT_NE(m.valence[c[0]], 6);
+      EXPECT_EQ(m.patch_of(t)[1], c[1]);
+      EXPECT_EQ(m.patch_of(t)[2], c[2]);
+    }
+    if (m.patch_kind[t] != ShellPatchKind::regular) continue;
+    // the limit surface of a regular patch lies within 2 % of the radius
+    Eigen::Matrix<double, 3, 12> X;
+    for (int a = 0; a < 12; ++a) X.col(a) = m.reference[m.patch_of(t)[a]];
+    EXPECT_CLOSE((X * basis[0].N - s.center).norm(), s.radius, 0.02, 0);
+  }
+  EXPECT_GT(counts[0], 0);
+  EXPECT_EQ(counts[3], 0);
+  EXPECT_EQ(counts[0] + counts[1] + counts[2], m.num_triangles());
+}
+
+TEST(ShellMesh, GmshOpenSurfacesHaveBoundaries) {
+  for (const char* shape : {"disk", "rectangle", "cylinder"}) {
+    ShellShapeSpec s;
+    s.shape = shape;
+    s.radius = 0.5;
+    s.length = 1.0;
+    s.width = 1.0;
+    s.height = 0.6;
+    s.axis = Vec3(1, 0, 0);
+    s.element_size = 0.1;
+    const ShellMesh m = mesh_shell_shape(s, shape);
+    Index edges = 0, boundary_vertices = 0;
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      edges += m.valence[v];
+      boundary_vertices += m.on_boundary[v];
+    }
+    // Euler characteristic: 1 for a disk or a rectangle, 0 for a tube
+    EXPECT_EQ(m.num_vertices() - edges / 2 + m.num_triangles(), std::string(shape) == "cylinder" ? 0 : 1) << shape;
+    EXPECT_GT(boundary_vertices, 0) << shape;
+    for (Index t = 0; t < m.num_triangles(); ++t) {
+      bool touches = false;
+      for (Index v : m.triangles[t]) touches = touches || m.on_boundary[v];
+      EXPECT_EQ(m.patch_kind[t] == ShellPatchKind::boundary, touches);
+    }
+  }
+  EXPECT_NE(input_error([] { mesh_shell_shape({.shape = "cone", .element_size = 0.1}, "bodies[0].mesh"); })
+                .find("bodies[0].mesh.shape: expected one of sphere, disk, rectangle, cylinder"),
+            std::string::npos);
+}
+
+TEST(ShellMesh, BadTriangleMeshesAreRefused) {
+  const std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0), Vec3(0, 0, 1),
+                               Vec3(-1, 0, 0), Vec3(0, -1, 0)};
+  auto error = [&](std::vector<std::array<Index, 3>> tris, std::vector<Vec3> points) {
+    return input_error([&] { build_shell_mesh(std::move(points), std::move(tris), "file.msh"); });
+  };
+  EXPECT_NE(error({{0, 1, 7}}, x).find("file.msh: triangle 0 names vertex 7 of 7"), std::string::npos);
+  EXPECT_NE(error({{0, 1, 1}}, x).find("triangle 0 repeats vertex 1"), std::string::npos);
+  EXPECT_NE(error({{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, x).find("the edge of vertices 0 and 1 has 3 or more"),
+            std::string::npos);
+  // two triangles meeting at vertex 0 only (a bow tie)
+  EXPECT_NE(error({{0, 1, 2}, {0, 3, 4}}, {x[0], x[1], x[2], x[5], x[6]}).find("triangles at vertex 0 do not form one fan"),
+            std::string::npos);
+  EXPECT_NE(error({{0, 1, 2}}, x).find("vertex 3 is in no triangle"), std::string::npos);
+  // a Moebius strip of 5 quads (10 triangles) is not orientable
+  std::vector<Vec3> strip;
+  std::vector<std::array<Index, 3>> tris;
+  const int k = 5;
+  for (int i = 0; i < k; ++i) {
+    const double a = 2 * std::numbers::pi * i / k;
+    for (int s : {-1, 1}) {
+      const double h = 0.3 * s;
+      strip.emplace_back((1 + h * std::cos(a / 2)) * std::cos(a), (1 + h * std::cos(a / 2)) * std::sin(a), h * std::sin(a / 2));
+    }
+  }
+  for (int i = 0; i < k; ++i) {
+    const Index a0 = 2 * i, a1 = 2 * i + 1;
+    const Index b0 = i + 1 < k ? 2 * i + 2 : 1, b1 = i + 1 < k ? 2 * i + 3 : 0;  // the half twist
+    tris.push_back({a0, b0, a1});
+    tris.push_back({a1, b0, b1});
+  }
+  EXPECT_NE(error(tris, strip).find("not orientable"), std::string::npos);
+}
