@@ -30,6 +30,7 @@
 #include <cmath>
 
 #include "kernels/loop_basis.hpp"
+#include "kernels/loop_extraordinary.hpp"
 #include "kernels/shell_plane_stress.hpp"
 #include "kernels/types.hpp"
 
@@ -61,6 +62,16 @@ std::array<SubdivisionBasis<12>, NQ> loop_regular_basis_at_quadrature() {
   std::array<SubdivisionBasis<12>, NQ> out;
   for (int q = 0; q < NQ; ++q)
     out[q] = loop_regular_basis(ShellQuadrature<NQ>::point[q][0], ShellQuadrature<NQ>::point[q][1]);
+  return out;
+}
+
+/// The basis of a patch with one extraordinary corner of valence N at the
+/// quadrature points (the same for every such patch).
+template <int N, int NQ>
+std::array<SubdivisionBasis<N + 6>, NQ> loop_extraordinary_basis_at_quadrature() {
+  std::array<SubdivisionBasis<N + 6>, NQ> out;
+  for (int q = 0; q < NQ; ++q)
+    out[q] = loop_extraordinary_basis<N>(ShellQuadrature<NQ>::point[q][0], ShellQuadrature<NQ>::point[q][1]);
   return out;
 }
 

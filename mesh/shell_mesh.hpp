@@ -16,7 +16,8 @@ namespace shatter {
 ///  regular:      three interior corners of valence 6; 12 control vertices in
 ///                kernels/loop_basis.hpp order (Stam's 1..12 as 0..11);
 ///  extraordinary: three interior corners, exactly one of valence N != 6;
-///                N + 6 control vertices in the order of ShellMesh::patch;
+///                N + 6 control vertices in the order of ShellMesh::patch
+///                (kernels/loop_extraordinary.hpp evaluates it);
 ///  several_extraordinary: more than one corner of valence != 6 (one Loop
 ///                subdivision of the control mesh separates them); no patch;
 ///  boundary:     a corner on the boundary; no patch (boundary rules or

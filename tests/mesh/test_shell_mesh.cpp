@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <numbers>
 
 #include "expect_close.hpp"
+#include "kernels/loop_extraordinary.hpp"
 #include "kernels/shell_kl.hpp"
 #include "mesh/mesh_test_helpers.hpp"
 #include "mesh/shell_gmsh.hpp"
@@ -33,6 +35,25 @@ ShellMesh lattice(int n, bool flip = false) {
       tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   return build_shell_mesh(std::move(x), std::move(tris), "lattice");
+}
+
+/// The limit surface point of triangle t at (v, w), from its patch.
+template <int K>
+Vec3 patch_point(const ShellMesh& m, Index t, const Eigen::Matrix<double, K, 1>& N) {
+  Vec3 x = Vec3::Zero();
+  for (int a = 0; a < K; ++a) x += N[a] * m.reference[m.patch_of(t)[a]];
+  return x;
+}
+Vec3 limit_point(const ShellMesh& m, Index t, double v, double w) {
+  switch (m.patch_size(t)) {
+    case 12: return patch_point<12>(m, t, loop_regular_basis(v, w).N);
+    case 9: return patch_point<9>(m, t, loop_extraordinary_basis<3>(v, w).N);
+    case 10: return patch_point<10>(m, t, loop_extraordinary_basis<4>(v, w).N);
+    case 11: return patch_point<11>(m, t, loop_extraordinary_basis<5>(v, w).N);
+    case 13: return patch_point<13>(m, t, loop_extraordinary_basis<7>(v, w).N);
+    case 14: return patch_point<14>(m, t, loop_extraordinary_basis<8>(v, w).N);
+    default: ADD_FAILURE() << "valence " << m.patch_size(t) - 6 << " not covered"; return Vec3::Zero();
+  }
 }
 
 Vec3 normal(const ShellMesh& m, Index t) {
@@ -137,7 +158,34 @@ TEST(ShellMesh, GmshSphereIsClosedOutwardAndItsPatchesLieOnTheSphere) {
     EXPECT_CLOSE((X * basis[0].N - s.center).norm(), s.radius, 0.02, 0);
   }
   EXPECT_GT(counts[0], 0);
+  EXPECT_GT(counts[1], 0);
   EXPECT_EQ(counts[3], 0);
+  // Neighbouring patches (regular or extraordinary) give the same limit
+  // surface on their common edge: the patch orders agree with the bases.
+  const double corner_vw[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  int shared = 0, shared_extraordinary = 0;
+  for (Index t = 0; t < m.num_triangles(); ++t)
+    for (Index u = t + 1; u < m.num_triangles(); ++u) {
+      if (m.patch_size(t) == 0 || m.patch_size(u) == 0) continue;
+      int kt[2], ku[2], n = 0;
+      for (int i = 0; i < 3 && n < 2; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (m.triangles[t][i] == m.triangles[u][j]) kt[n] = i, ku[n++] = j;
+      if (n < 2) continue;
+      ++shared;
+      shared_extraordinary += m.patch_size(t) != 12 || m.patch_size(u) != 12;
+      for (double f : {0.25, 0.5}) {  // a point of the edge, seen from both sides
+        auto along = [&](const int k[2], int c) { return (1 - f) * corner_vw[k[0]][c] + f * corner_vw[k[1]][c]; };
+        const Vec3 xt = limit_point(m, t, along(kt, 0), along(kt, 1));
+        const Vec3 xu = limit_point(m, u, along(ku, 0), along(ku, 1));
+        EXPECT_LT((xt - xu).norm(), 1e-13 * s.radius) << "triangles " << t << " and " << u;
+      }
+    }
+  EXPECT_GT(shared, m.num_triangles());
+  EXPECT_GT(shared_extraordinary, 10);
+  std::cout << "sphere: " << m.num_vertices() << " vertices, " << m.num_triangles() << " triangles: " << counts[0]
+            << " regular, " << counts[1] << " extraordinary, " << counts[2] << " with several; " << shared
+            << " shared edges checked, " << shared_extraordinary << " next to an extraordinary patch\n";
   EXPECT_EQ(counts[0] + counts[1] + counts[2], m.num_triangles());
 }
 
