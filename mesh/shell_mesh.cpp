@@ -1,9 +1,11 @@
 #include "mesh/shell_mesh.hpp"
 
 #include <algorithm>
+#include <map>
 #include <unordered_map>
 
 #include "kernels/error.hpp"
+#include "kernels/loop_basis.hpp"
 
 namespace shatter {
 namespace {
@@ -66,6 +68,91 @@ void orient(std::vector<std::array<Index, 3>>& tris, const std::vector<Vec3>& x,
   }
 }
 
+/// opposite(p, q) = r for every oriented triangle (p, q, r), -1 when no
+/// triangle holds the directed edge p -> q.
+class OppositeVertex {
+ public:
+  explicit OppositeVertex(const std::vector<std::array<Index, 3>>& tris) {
+    map_.reserve(3 * tris.size());
+    for (const auto& c : tris)
+      for (int k = 0; k < 3; ++k) map_[edge_key(c[k], c[(k + 1) % 3])] = c[(k + 2) % 3];
+  }
+  Index operator()(Index p, Index q) const {
+    const auto it = map_.find(edge_key(p, q));
+    return it == map_.end() ? Index{-1} : it->second;
+  }
+
+ private:
+  std::unordered_map<EdgeKey, Index> map_;
+};
+
+using Lattice = std::array<int, 2>;
+
+/// The 12-vertex patch of triangle c (corners 4, 7, 8 = c[0], c[1], c[2])
+/// with a corner on the boundary, completed by ghost vertices, or false.
+/// The fans of the three corners are unfolded onto the regular lattice
+/// (each must fit it: interior corners of valence 6, no overlap); a lattice
+/// point of the patch with no vertex becomes a ghost x_B1 + x_B2 - x_A, the
+/// reflection through the midpoint of a boundary edge (B1, B2) at lattice
+/// distance 1 of it of the edge triangle's third vertex A (CO2000 sec. 4.4).
+/// New ghost rules are appended to m.ghost_rule (deduplicated by `ghost_id`).
+bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::array<Index, 3>& c,
+                           std::map<std::array<Index, 3>, Index>& ghost_id, std::array<Index, 12>& patch) {
+  // rot60(d): the lattice vector d turned by +60 degrees
+  auto rot60 = [](Lattice d) { return Lattice{-d[1], d[0] + d[1]}; };
+  auto add = [](Lattice a, Lattice b, int s) { return Lattice{a[0] + s * b[0], a[1] + s * b[1]}; };
+  std::map<Index, Lattice> at;
+  bool flat = true;
+  auto place = [&](Index v, Lattice x) {
+    const auto [it, inserted] = at.try_emplace(v, x);
+    flat = flat && (inserted || it->second == x);
+  };
+  place(c[0], {0, 0});
+  place(c[1], {1, 0});
+  place(c[2], {0, 1});
+  for (int k = 0; k < 3 && flat; ++k) {
+    const Index p = c[k], q = c[(k + 1) % 3];
+    if (!m.on_boundary[p] && m.valence[p] != 6) return false;
+    // counter-clockwise: triangle (p, prev, r) has r = p + rot60(prev - p)
+    Index prev = q;
+    for (Index r = opp(p, prev); r >= 0 && r != q && flat; prev = r, r = opp(p, prev))
+      place(r, add(at[p], rot60(add(at[prev], at[p], -1)), 1));
+    // clockwise: triangle (prev, p, s) has s = prev + rot60(p - prev)
+    prev = q;
+    for (Index s = opp(prev, p); s >= 0 && s != q && flat; prev = s, s = opp(prev, p))
+      place(s, add(at[prev], rot60(add(at[p], at[prev], -1)), 1));
+  }
+  if (!flat) return false;
+  std::map<Lattice, Index> vertex_at;
+  for (const auto& [v, x] : at)
+    if (!vertex_at.emplace(x, v).second) return false;  // the fans overlap: not a flat lattice
+  static constexpr Lattice kAround[6] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
+  for (int a = 0; a < 12; ++a) {
+    const Lattice P{kLoopRegularLattice[a][0], kLoopRegularLattice[a][1]};
+    if (const auto it = vertex_at.find(P); it != vertex_at.end()) {
+      patch[a] = it->second;
+      continue;
+    }
+    patch[a] = -1;
+    for (int k = 0; k < 6 && patch[a] < 0; ++k) {
+      const auto b1 = vertex_at.find(add(P, kAround[k], 1)), b2 = vertex_at.find(add(P, kAround[(k + 1) % 6], 1));
+      if (b1 == vertex_at.end() || b2 == vertex_at.end()) continue;
+      const Index B1 = b1->second, B2 = b2->second;
+      const Index A12 = opp(B1, B2), A21 = opp(B2, B1);
+      if ((A12 >= 0) == (A21 >= 0)) continue;  // not a boundary edge
+      const Index A = A12 >= 0 ? A12 : A21;
+      const Lattice reflected = add(add(b1->first, b2->first, 1), P, -1);
+      if (const auto ia = at.find(A); ia != at.end() && ia->second != reflected) continue;
+      const std::array<Index, 3> rule{std::min(B1, B2), std::max(B1, B2), A};
+      const auto [g, inserted] = ghost_id.try_emplace(rule, static_cast<Index>(m.ghost_rule.size()));
+      if (inserted) m.ghost_rule.push_back(rule);
+      patch[a] = m.num_vertices() + g->second;
+    }
+    if (patch[a] < 0) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Index, 3>> triangles,
@@ -97,15 +184,7 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
     if (incident[v] == 0) throw InputError(where + ": vertex " + std::to_string(v) + " is in no triangle");
   orient(m.triangles, m.reference, edge_triangles, where);
 
-  // opposite[(p, q)] = r for every oriented triangle (p, q, r)
-  std::unordered_map<EdgeKey, Index> opposite;
-  opposite.reserve(3 * static_cast<std::size_t>(nt));
-  for (const auto& c : m.triangles)
-    for (int k = 0; k < 3; ++k) opposite[edge_key(c[k], c[(k + 1) % 3])] = c[(k + 2) % 3];
-  auto opp = [&](Index p, Index q) {
-    const auto it = opposite.find(edge_key(p, q));
-    return it == opposite.end() ? Index{-1} : it->second;
-  };
+  const OppositeVertex opp(m.triangles);
 
   m.valence.assign(n, 0);
   m.on_boundary.assign(n, 0);
@@ -142,6 +221,7 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
   };
   m.patch_kind.resize(nt);
   m.patch_offsets.assign(1, 0);
+  std::map<std::array<Index, 3>, Index> ghost_id;
   for (Index t = 0; t < nt; ++t) {
     auto& c = m.triangles[t];
     int irregular = 0, first_irregular = 0;
@@ -150,8 +230,12 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
       boundary = boundary || m.on_boundary[c[k]];
       if (m.valence[c[k]] != 6 && irregular++ == 0) first_irregular = k;
     }
-    if (boundary) {
+    std::array<Index, 12> completed;
+    if (boundary && ghost_completed_patch(m, opp, c, ghost_id, completed)) {
       m.patch_kind[t] = ShellPatchKind::boundary;
+      m.patch.insert(m.patch.end(), completed.begin(), completed.end());
+    } else if (boundary) {
+      m.patch_kind[t] = ShellPatchKind::unsupported_boundary;
     } else if (irregular > 1) {
       m.patch_kind[t] = ShellPatchKind::several_extraordinary;
     } else {

@@ -20,9 +20,20 @@ namespace shatter {
 ///                (kernels/loop_extraordinary.hpp evaluates it);
 ///  several_extraordinary: more than one corner of valence != 6 (one Loop
 ///                subdivision of the control mesh separates them); no patch;
-///  boundary:     a corner on the boundary; no patch (boundary rules or
-///                ghost vertices are not implemented: docs/shells.md).
-enum class ShellPatchKind : std::uint8_t { regular, extraordinary, several_extraordinary, boundary };
+///  boundary:     a corner on the boundary, the fans of the corners fit the
+///                regular lattice and every missing lattice point of the
+///                patch is next to a boundary edge: 12 control vertices in
+///                Stam's order, some of them ghost vertices (ghost_rule);
+///  unsupported_boundary: any other triangle with a corner on the boundary
+///                (e.g. at a corner of the boundary, or an extraordinary
+///                vertex next to it); no patch.
+enum class ShellPatchKind : std::uint8_t {
+  regular,
+  extraordinary,
+  several_extraordinary,
+  boundary,
+  unsupported_boundary
+};
 
 /// A triangle control mesh, consistently oriented.
 ///
@@ -42,6 +53,14 @@ enum class ShellPatchKind : std::uint8_t { regular, extraordinary, several_extra
 ///       corner (1 = triangles[t][1], 2 = triangles[t][2], N = the vertex
 ///       across the edge p-[1]); N+1..N+5: Stam's vertices 6, 10, 11, 12, 9
 ///       (beyond corner [1], across the edge [1]-[2], beyond corner [2]).
+///     boundary: as regular; an entry n + g (n = num_vertices()) is ghost g.
+///   ghost_rule[g] = {b1, b2, a}: ghost vertex g sits at x_b1 + x_b2 - x_a,
+///     the reflection of a through the midpoint of the boundary edge
+///     (b1, b2) of triangle (b1, b2, a) (Cirak, Ortiz & Schroeder 2000,
+///     sec. 4.4); its force goes to b1 and b2 and, negated, to a, which
+///     keeps the sum of forces and of their moments. With the boundary
+///     vertices held, the edge is simply supported; held with the next row
+///     too, clamped; free otherwise (docs/shells.md).
 struct ShellMesh {
   std::vector<Vec3> reference;
   std::vector<std::array<Index, 3>> triangles;
@@ -50,6 +69,7 @@ struct ShellMesh {
   std::vector<ShellPatchKind> patch_kind;
   std::vector<Index> patch_offsets;
   std::vector<Index> patch;
+  std::vector<std::array<Index, 3>> ghost_rule;
 
   Index num_vertices() const { return static_cast<Index>(reference.size()); }
   Index num_triangles() const { return static_cast<Index>(triangles.size()); }
