@@ -2,7 +2,7 @@
 // Loop subdivision basis of a regular patch: the 12 quartic box-spline
 // shape functions of a triangle whose three corners have valence 6
 // (Stam, "Evaluation of Loop subdivision surfaces", SIGGRAPH 1998, appendix;
-// Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072, eq. (A.1)).
+// Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072, appendix).
 //
 // Parametrisation: a point of the triangle is (v, w), u = 1 - v - w, with
 // corner 4 at (0, 0), corner 7 at (1, 0) and corner 8 at (0, 1) (Stam's

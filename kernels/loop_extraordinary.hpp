@@ -1,10 +1,10 @@
 #pragma once
 // Loop basis of a patch with one extraordinary corner (valence N != 6), by
-// local subdivision (Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072,
-// sec. 4.3; Stam, SIGGRAPH 1998, sec. 3): the patch is subdivided until the
-// point falls in one of the three regular sub-triangles that surround the
-// corner's sub-triangle, where the regular box-spline patch
-// (kernels/loop_basis.hpp) applies.
+// local subdivision (Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072;
+// Stam, SIGGRAPH 1998, also gives the eigenbasis alternative): the patch is
+// subdivided until the point falls in one of the three regular sub-triangles
+// that surround the corner's sub-triangle, where the regular box-spline
+// patch (kernels/loop_basis.hpp) applies.
 //
 // Patch order (K = N + 6, as mesh/shell_mesh.hpp): 0 the extraordinary
 // corner p at (v, w) = (0, 0); 1..N its ring counter-clockwise, 1 at (1, 0)

@@ -7,9 +7,9 @@
 // regular patch). With theta = (v, w), at a quadrature point:
 //   a_alpha = x_{,alpha},  a_3 = a_1 x a_2 / j,  j = |a_1 x a_2|,
 //   a_{alpha beta} = a_alpha . a_beta,   b_{alpha beta} = a_3 . x_{,alpha beta}
-// (2000, eqs. 3-8) and the same of the reference positions X_a: A, B.
+// (Cirak et al. 2000) and the same of the reference positions X_a: A, B.
 // A shell point at theta_3 in [-t/2, t/2] has, to first order in theta_3
-// (the thin-shell approximation the papers make, 2000 eq. 11),
+// (the thin-shell approximation of the papers),
 //   g_{alpha beta} = a_{alpha beta} - 2 theta_3 b_{alpha beta},
 //   G_{alpha beta} = A_{alpha beta} - 2 theta_3 B_{alpha beta},
 // so E = (g - G)/2 = alpha + theta_3 beta with the membrane strain
@@ -170,7 +170,7 @@ ShellForce<NV> shell_internal_force(const Eigen::Matrix<double, 3, NV>& x,
 }
 
 /// Lumped (row-sum) mass of the element's control vertices, kg:
-/// m_a = rho t sum_q w_q J0_q N_a (Cirak et al. 2000 sec. 5; a sum over the
+/// m_a = rho t sum_q w_q J0_q N_a (row sums of the consistent mass; a sum over the
 /// elements gives each vertex rho t int N_a dA, total rho t x area).
 template <int NV, int NQ>
 Eigen::Matrix<double, NV, 1> shell_lumped_mass(const std::array<SubdivisionBasis<NV>, NQ>& basis,

@@ -3,7 +3,7 @@
 //   W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2
 // in plane stress, at one point through the thickness of a Kirchhoff-Love
 // shell, in the convected frame of the shell (Cirak & Ortiz, IJNME 51 (2001)
-// 813-833, sec. 3.2: the normal stretch is condensed out by S^33 = 0).
+// 813-833: the normal stretch is condensed out by S^33 = 0).
 //
 // With g_ab and G_ab the current and reference in-plane metrics at the point
 // and C33 = lambda_3^2 the squared normal stretch (the normal stays normal,

@@ -94,7 +94,7 @@ using Lattice = std::array<int, 2>;
 /// (each must fit it: interior corners of valence 6, no overlap); a lattice
 /// point of the patch with no vertex becomes a ghost x_B1 + x_B2 - x_A, the
 /// reflection through the midpoint of a boundary edge (B1, B2) at lattice
-/// distance 1 of it of the edge triangle's third vertex A (CO2000 sec. 4.4).
+/// distance 1 of it of the edge triangle's third vertex A.
 /// New ghost rules are appended to m.ghost_rule (deduplicated by `ghost_id`).
 bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::array<Index, 3>& c,
                            std::map<std::array<Index, 3>, Index>& ghost_id, std::array<Index, 12>& patch) {

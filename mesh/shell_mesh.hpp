@@ -1,6 +1,6 @@
 #pragma once
 // Triangle control mesh of a shell's mid-surface and the Loop patch of each
-// triangle (Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072, sec. 4):
+// triangle (Cirak, Ortiz & Schroeder, IJNME 47 (2000) 2039-2072):
 // the control vertices whose shape functions are non-zero on the triangle,
 // i.e. the triangle's corners and their 1-rings.
 #include <array>
@@ -56,8 +56,8 @@ enum class ShellPatchKind : std::uint8_t {
 ///     boundary: as regular; an entry n + g (n = num_vertices()) is ghost g.
 ///   ghost_rule[g] = {b1, b2, a}: ghost vertex g sits at x_b1 + x_b2 - x_a,
 ///     the reflection of a through the midpoint of the boundary edge
-///     (b1, b2) of triangle (b1, b2, a) (Cirak, Ortiz & Schroeder 2000,
-///     sec. 4.4); its force goes to b1 and b2 and, negated, to a, which
+///     (b1, b2) of triangle (b1, b2, a), as ghost vertices are used for
+///     boundaries in Cirak et al. (2000); its force goes to b1 and b2 and, negated, to a, which
 ///     keeps the sum of forces and of their moments. With the boundary
 ///     vertices held, the edge is simply supported; held with the next row
 ///     too, clamped; free otherwise (docs/shells.md).
