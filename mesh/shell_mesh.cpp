@@ -1,6 +1,7 @@
 #include "mesh/shell_mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <unordered_map>
 
@@ -92,9 +93,8 @@ using Lattice = std::array<int, 2>;
 /// with a corner on the boundary, completed by ghost vertices, or false.
 /// The fans of the three corners are unfolded onto the regular lattice
 /// (each must fit it: interior corners of valence 6, no overlap); a lattice
-/// point of the patch with no vertex becomes a ghost x_B1 + x_B2 - x_A, the
-/// reflection through the midpoint of a boundary edge (B1, B2) at lattice
-/// distance 1 of it of the edge triangle's third vertex A.
+/// point of the patch with no vertex, next to a boundary edge, becomes a
+/// ghost vertex (the candidates are below).
 /// New ghost rules are appended to m.ghost_rule (deduplicated by `ghost_id`).
 bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::array<Index, 3>& c,
                            std::map<std::array<Index, 3>, Index>& ghost_id, std::array<Index, 12>& patch) {
@@ -133,22 +133,40 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::a
       patch[a] = it->second;
       continue;
     }
-    patch[a] = -1;
-    for (int k = 0; k < 6 && patch[a] < 0; ++k) {
+    // Candidates, for each boundary edge (B1, B2) next to P: the reflection
+    // of the edge triangle's third vertex A through the edge's midpoint
+    // (B1 + B2 - A), and of the vertex Q = 2 B - P through either end B
+    // (2 B - Q). All put the ghost on the lattice point; the one whose
+    // partner (A or Q) is the ghost's mirror image across the edge (its
+    // offset most nearly normal to the edge) is taken, so that held
+    // boundary vertices make an odd reflection of the control net.
+    std::array<Index, 3> best{};
+    double best_score = HUGE_VAL;
+    auto consider = [&](const std::array<Index, 3>& rule, Index partner, const Vec3& edge) {
+      const Vec3 ghost = m.reference[rule[0]] + m.reference[rule[1]] - m.reference[rule[2]];
+      const Vec3 d = m.reference[partner] - ghost;
+      const double score = std::abs(d.dot(edge)) / (d.norm() * edge.norm());
+      if (score < best_score - 1e-9) best_score = score, best = rule;
+    };
+    for (int k = 0; k < 6; ++k) {
       const auto b1 = vertex_at.find(add(P, kAround[k], 1)), b2 = vertex_at.find(add(P, kAround[(k + 1) % 6], 1));
       if (b1 == vertex_at.end() || b2 == vertex_at.end()) continue;
       const Index B1 = b1->second, B2 = b2->second;
       const Index A12 = opp(B1, B2), A21 = opp(B2, B1);
       if ((A12 >= 0) == (A21 >= 0)) continue;  // not a boundary edge
       const Index A = A12 >= 0 ? A12 : A21;
+      const Vec3 edge = m.reference[B2] - m.reference[B1];
       const Lattice reflected = add(add(b1->first, b2->first, 1), P, -1);
-      if (const auto ia = at.find(A); ia != at.end() && ia->second != reflected) continue;
-      const std::array<Index, 3> rule{std::min(B1, B2), std::max(B1, B2), A};
-      const auto [g, inserted] = ghost_id.try_emplace(rule, static_cast<Index>(m.ghost_rule.size()));
-      if (inserted) m.ghost_rule.push_back(rule);
-      patch[a] = m.num_vertices() + g->second;
+      if (const auto ia = at.find(A); ia == at.end() || ia->second == reflected)
+        consider({std::min(B1, B2), std::max(B1, B2), A}, A, edge);
+      for (const auto& b : {b1, b2})
+        if (const auto q = vertex_at.find(add(add(b->first, b->first, 1), P, -1)); q != vertex_at.end())
+          consider({b->second, b->second, q->second}, q->second, edge);
     }
-    if (patch[a] < 0) return false;
+    if (best_score == HUGE_VAL) return false;
+    const auto [g, inserted] = ghost_id.try_emplace(best, static_cast<Index>(m.ghost_rule.size()));
+    if (inserted) m.ghost_rule.push_back(best);
+    patch[a] = m.num_vertices() + g->second;
   }
   return true;
 }

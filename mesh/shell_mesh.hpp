@@ -54,11 +54,13 @@ enum class ShellPatchKind : std::uint8_t {
 ///       across the edge p-[1]); N+1..N+5: Stam's vertices 6, 10, 11, 12, 9
 ///       (beyond corner [1], across the edge [1]-[2], beyond corner [2]).
 ///     boundary: as regular; an entry n + g (n = num_vertices()) is ghost g.
-///   ghost_rule[g] = {b1, b2, a}: ghost vertex g sits at x_b1 + x_b2 - x_a,
-///     the reflection of a through the midpoint of the boundary edge
-///     (b1, b2) of triangle (b1, b2, a), as ghost vertices are used for
-///     boundaries in Cirak et al. (2000); its force goes to b1 and b2 and, negated, to a, which
-///     keeps the sum of forces and of their moments. With the boundary
+///   ghost_rule[g] = {b1, b2, a}: ghost vertex g sits at x_b1 + x_b2 - x_a
+///     (ghost vertices as Cirak et al. (2000) use them at boundaries): the
+///     reflection of a through the midpoint of a boundary edge (b1, b2), or
+///     through a boundary vertex b1 = b2, whichever makes a the mirror image
+///     of the ghost across the boundary in the reference configuration; its
+///     force goes to b1 and b2 and, negated, to a, which keeps the sum of
+///     forces and of their moments. With the boundary
 ///     vertices held, the edge is simply supported; held with the next row
 ///     too, clamped; free otherwise (docs/shells.md).
 struct ShellMesh {

@@ -117,6 +117,7 @@ TEST(ShellPlate, SimplySupportedFirstFrequencyConverges) {
     std::cout << "simply supported plate, " << n - 1 << " x " << n - 1 << " cells: omega " << omega << " (exact "
               << exact << "), error " << errors.back() << ", " << skipped << " corner triangles without a patch\n";
   }
+  // measured -8.3 %, -2.6 %, -0.82 % (and, once, -0.44 % at 48, -0.29 % at 64)
   EXPECT_LT(std::abs(errors.back()), 0.02);
   EXPECT_LT(std::abs(errors[2]), std::abs(errors[1]));
   EXPECT_LT(std::abs(errors[1]), std::abs(errors[0]));
