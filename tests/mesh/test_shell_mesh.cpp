@@ -12,6 +12,7 @@
 #include "mesh/mesh_test_helpers.hpp"
 #include "mesh/shell_gmsh.hpp"
 #include "mesh/shell_mesh.hpp"
+#include "mesh/shell_subdivision.hpp"
 
 using namespace shatter;
 using shatter::test::input_error;
@@ -273,6 +274,35 @@ TEST(ShellMesh, GmshSphereIsClosedOutwardAndItsPatchesLieOnTheSphere) {
             << " regular, " << counts[1] << " extraordinary, " << counts[2] << " with several; " << shared
             << " shared edges checked, " << shared_extraordinary << " next to an extraordinary patch\n";
   EXPECT_EQ(counts[0] + counts[1] + counts[2], m.num_triangles());
+}
+
+TEST(ShellMesh, LoopSubdivisionKeepsTheLimitSurfaceAndSeparatesExtraordinaryVertices) {
+  ShellShapeSpec s;
+  s.shape = "sphere";
+  s.radius = 0.12;
+  s.element_size = 0.03;
+  const ShellMesh coarse = mesh_shell_shape(s, "sphere");
+  const ShellMesh fine = loop_subdivide(coarse, "sphere");
+  Index edges = 0;
+  for (Index v = 0; v < coarse.num_vertices(); ++v) edges += coarse.valence[v];
+  EXPECT_EQ(fine.num_vertices(), coarse.num_vertices() + edges / 2);
+  ASSERT_EQ(fine.num_triangles(), 4 * coarse.num_triangles());
+  int several = 0, compared = 0;
+  for (Index t = 0; t < fine.num_triangles(); ++t) several += fine.patch_kind[t] == ShellPatchKind::several_extraordinary;
+  EXPECT_EQ(several, 0);
+  // Where the coarse triangle has a patch, the limit surface is the same:
+  // at its centroid (the centroid of its central sub-triangle 4t + 3) and at
+  // (0.1, 0.1) (sub-triangle 4t at (0.2, 0.2)).
+  for (Index t = 0; t < coarse.num_triangles(); ++t) {
+    if (coarse.patch_size(t) == 0) continue;
+    ++compared;
+    EXPECT_LT((limit_point(coarse, t, 1.0 / 3, 1.0 / 3) - limit_point(fine, 4 * t + 3, 1.0 / 3, 1.0 / 3)).norm(),
+              1e-14 * s.radius)
+        << "triangle " << t;
+    EXPECT_LT((limit_point(coarse, t, 0.1, 0.1) - limit_point(fine, 4 * t, 0.2, 0.2)).norm(), 1e-14 * s.radius)
+        << "triangle " << t;
+  }
+  EXPECT_GT(compared, coarse.num_triangles() / 2);
 }
 
 TEST(ShellMesh, GmshOpenSurfacesHaveBoundaries) {
