@@ -3,8 +3,8 @@
 // subdivision surfaces based on triangles", MS thesis, Utah, 1987): every
 // triangle becomes four, and the new control mesh has the same limit
 // surface in the interior. Used once before a run, it leaves at most one
-// extraordinary corner per triangle (Cirak, Ortiz & Schroeder 2000 do the
-// same), so that every interior triangle has a patch.
+// extraordinary corner per triangle (what the element of Cirak, Ortiz &
+// Schroeder 2000 assumes), so that every interior triangle has a patch.
 #include <string>
 
 #include "mesh/shell_mesh.hpp"
