@@ -50,9 +50,11 @@ void scatter(const ShellMesh& m, Index id, Add add) {
 }
 
 /// Lowest angular frequency of the plate's out-of-plane motion with the
-/// boundary vertices held, from K (central differences of the exact forces)
-/// and the lumped mass. Also counts the triangles without a patch.
-double first_frequency(const ShellMesh& m, double t, const NeoHookean& mat, int& skipped) {
+/// vertices for which `held` is true fixed, from K (central differences of
+/// the exact forces) and the lumped mass. Also counts the triangles without
+/// a patch.
+template <class Held>
+double first_frequency(const ShellMesh& m, double t, const NeoHookean& mat, Held held, int& skipped) {
   const auto basis = loop_regular_basis_at_quadrature<3>();
   std::vector<Index> elems;
   std::vector<ShellReference<3>> refs;
@@ -72,7 +74,7 @@ double first_frequency(const ShellMesh& m, double t, const NeoHookean& mat, int&
   }
   std::vector<Index> free;  // interior vertices: their z is the unknown
   for (Index v = 0; v < m.num_vertices(); ++v)
-    if (!m.on_boundary[v]) free.push_back(v);
+    if (!held(v)) free.push_back(v);
   auto force_z = [&](const std::vector<Vec3>& x) {
     std::vector<double> f(m.num_vertices(), 0.0);
     for (std::size_t k = 0; k < elems.size(); ++k) {
@@ -112,7 +114,8 @@ TEST(ShellPlate, SimplySupportedFirstFrequencyConverges) {
   std::vector<double> errors;
   for (int n : {9, 17, 33}) {
     int skipped = 0;
-    const double omega = first_frequency(square_plate(n, a), t, mat, skipped);
+    const ShellMesh m = square_plate(n, a);
+    const double omega = first_frequency(m, t, mat, [&](Index v) { return m.on_boundary[v] != 0; }, skipped);
     errors.push_back(omega / exact - 1);
     std::cout << "simply supported plate, " << n - 1 << " x " << n - 1 << " cells: omega " << omega << " (exact "
               << exact << "), error " << errors.back() << ", " << skipped << " corner triangles without a patch\n";
@@ -121,4 +124,35 @@ TEST(ShellPlate, SimplySupportedFirstFrequencyConverges) {
   EXPECT_LT(std::abs(errors.back()), 0.02);
   EXPECT_LT(std::abs(errors[2]), std::abs(errors[1]));
   EXPECT_LT(std::abs(errors[1]), std::abs(errors[0]));
+}
+
+TEST(ShellPlate, ClampedFirstFrequencyConverges) {
+  // Clamped: the boundary vertices and the next row held, which fixes the
+  // slope at the edge through the ghost vertices, but also w one row inside:
+  // first-order convergence, the error halving with h (measured +11.8 %,
+  // +6.8 %, +3.5 %; the 2 % needs 64 cells). Square CCCC plate:
+  // omega a^2 sqrt(rho t / D) = 35.985 (Leissa, "Vibration of plates",
+  // NASA SP-160, 1969, table 4.23).
+  const double a = 1.0, t = 0.01, E = 2.1e11, nu = 0.3, rho = 7850;
+  const NeoHookean mat = NeoHookean::from_young_poisson(E, nu, rho);
+  const double D = E * t * t * t / (12 * (1 - nu * nu));
+  const double exact = 35.985 / (a * a) * std::sqrt(D / (rho * t));
+  std::vector<double> errors;
+  for (int n : {9, 17, 33}) {
+    int skipped = 0;
+    const ShellMesh m = square_plate(n, a);
+    auto held = [&](Index v) {
+      const int i = v % n, j = v / n;
+      return i <= 1 || j <= 1 || i >= n - 2 || j >= n - 2;
+    };
+    const double omega = first_frequency(m, t, mat, held, skipped);
+    errors.push_back(omega / exact - 1);
+    std::cout << "clamped plate, " << n - 1 << " x " << n - 1 << " cells: omega " << omega << " (exact " << exact
+              << "), error " << errors.back() << "\n";
+  }
+  EXPECT_GT(errors[2], 0);
+  EXPECT_LT(errors.back(), 0.04);
+  const double order = std::log2(errors[1] / errors[2]);
+  EXPECT_GT(order, 0.85);
+  EXPECT_LT(order, 1.2);
 }
