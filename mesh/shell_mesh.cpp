@@ -165,7 +165,10 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::a
     }
     if (best_score == HUGE_VAL) return false;
     const auto [g, inserted] = ghost_id.try_emplace(best, static_cast<Index>(m.ghost_rule.size()));
-    if (inserted) m.ghost_rule.push_back(best);
+    if (inserted) {
+      m.ghost_rule.push_back(best);
+      m.ghost_mode.push_back(GhostMode::odd);
+    }
     patch[a] = m.num_vertices() + g->second;
   }
   return true;

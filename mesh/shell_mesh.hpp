@@ -60,9 +60,15 @@ enum class ShellPatchKind : std::uint8_t {
 ///     through a boundary vertex b1 = b2, whichever makes a the mirror image
 ///     of the ghost across the boundary in the reference configuration; its
 ///     force goes to b1 and b2 and, negated, to a, which keeps the sum of
-///     forces and of their moments. With the boundary
-///     vertices held, the edge is simply supported; held with the next row
-///     too, clamped; free otherwise (docs/shells.md).
+///     forces and of their moments. With the boundary vertices held, the
+///     edge is simply supported; free otherwise (docs/shells.md).
+///   ghost_mode[g]: odd (the rule above) or even: the ghost moves with a,
+///     x_g = x_a + (X_b1 + X_b2 - 2 X_a) with X the reference positions, its
+///     force going to a alone. Even ghosts with the boundary vertices held
+///     make a clamped edge (zero slope across it); they keep the sum of
+///     forces but not of moments, as a clamp does not.
+enum class GhostMode : std::uint8_t { odd, even };
+
 struct ShellMesh {
   std::vector<Vec3> reference;
   std::vector<std::array<Index, 3>> triangles;
@@ -72,11 +78,34 @@ struct ShellMesh {
   std::vector<Index> patch_offsets;
   std::vector<Index> patch;
   std::vector<std::array<Index, 3>> ghost_rule;
+  std::vector<GhostMode> ghost_mode;
 
   Index num_vertices() const { return static_cast<Index>(reference.size()); }
   Index num_triangles() const { return static_cast<Index>(triangles.size()); }
   const Index* patch_of(Index t) const { return patch.data() + patch_offsets[t]; }
   Index patch_size(Index t) const { return patch_offsets[t + 1] - patch_offsets[t]; }
+
+  /// Position of patch entry `id` (a vertex, or ghost id - n) from the vertex positions x.
+  Vec3 entry_position(const std::vector<Vec3>& x, Index id) const {
+    if (id < num_vertices()) return x[id];
+    const Index g = id - num_vertices();
+    const auto& [b1, b2, a] = ghost_rule[g];
+    if (ghost_mode[g] == GhostMode::even) return x[a] + (reference[b1] + reference[b2] - 2.0 * reference[a]);
+    return x[b1] + x[b2] - x[a];
+  }
+
+  /// Call add(vertex, weight) for the vertices patch entry `id` stands for:
+  /// its force (or lumped mass) v goes to each vertex as weight x v.
+  template <class Add>
+  void scatter_entry(Index id, Add&& add) const {
+    if (id < num_vertices()) return add(id, 1.0);
+    const Index g = id - num_vertices();
+    const auto& [b1, b2, a] = ghost_rule[g];
+    if (ghost_mode[g] == GhostMode::even) return add(a, 1.0);
+    add(b1, 1.0);
+    add(b2, 1.0);
+    add(a, -1.0);
+  }
 };
 
 /// Build the control mesh from vertex positions and triangles (any

@@ -63,13 +63,6 @@ Vec3 normal(const ShellMesh& m, Index t) {
 }
 }  // namespace
 
-/// Position of patch entry `id`: a vertex, or a ghost past the vertices.
-Vec3 slot_position(const ShellMesh& m, const std::vector<Vec3>& x, Index id) {
-  if (id < m.num_vertices()) return x[id];
-  const auto& [b1, b2, a] = m.ghost_rule[id - m.num_vertices()];
-  return x[b1] + x[b2] - x[a];
-}
-
 TEST(ShellMesh, LatticePatchesFollowTheLoopBasisOrder) {
   // Every triangle has its 12-vertex patch at the lattice offsets of
   // kernels/loop_basis.hpp, boundary ones through ghost vertices (which a
@@ -110,7 +103,7 @@ TEST(ShellMesh, LatticePatchesFollowTheLoopBasisOrder) {
       EXPECT_EQ(p[7], m.triangles[t][2]);
       const Vec3 x4 = m.reference[p[3]], e1 = m.reference[p[6]] - x4, e2 = m.reference[p[7]] - x4;
       for (int a = 0; a < 12; ++a)
-        EXPECT_LT((slot_position(m, m.reference, p[a]) -
+        EXPECT_LT((m.entry_position(m.reference, p[a]) -
                    (x4 + kLoopRegularLattice[a][0] * e1 + kLoopRegularLattice[a][1] * e2)).norm(),
                   1e-12)
             << "triangle " << t << " patch vertex " << a;
@@ -142,22 +135,14 @@ TEST(ShellMesh, GhostVerticesKeepContinuityAndMomentumBalance) {
     if (m.patch_size(t) != 12) continue;
     Eigen::Matrix<double, 3, 12> Xe, xe;
     for (int a = 0; a < 12; ++a) {
-      Xe.col(a) = slot_position(m, X, m.patch_of(t)[a]);
-      xe.col(a) = slot_position(m, x, m.patch_of(t)[a]);
+      Xe.col(a) = m.entry_position(X, m.patch_of(t)[a]);
+      xe.col(a) = m.entry_position(x, m.patch_of(t)[a]);
     }
     const auto out = shell_internal_force<12, 3>(xe, basis, shell_reference<12, 3>(Xe, basis, 0.05), mat);
     fnorm = std::max(fnorm, out.f.norm());
     for (int a = 0; a < 12; ++a) {
-      const Index id = m.patch_of(t)[a];
-      if (id < m.num_vertices()) {
-        f[id] += out.f.col(a);
-        continue;
-      }
-      ++ghosts_used;
-      const auto& [b1, b2, v] = m.ghost_rule[id - m.num_vertices()];
-      f[b1] += out.f.col(a);
-      f[b2] += out.f.col(a);
-      f[v] -= out.f.col(a);
+      ghosts_used += m.patch_of(t)[a] >= m.num_vertices();
+      m.scatter_entry(m.patch_of(t)[a], [&](Index v, double w) { f[v] += w * out.f.col(a); });
     }
   }
   ASSERT_GT(ghosts_used, 0);
@@ -166,7 +151,7 @@ TEST(ShellMesh, GhostVerticesKeepContinuityAndMomentumBalance) {
   auto limit = [&](Index t, double v, double w) {
     const auto N = loop_regular_basis(v, w).N;
     Vec3 p = Vec3::Zero();
-    for (int a = 0; a < 12; ++a) p += N[a] * slot_position(m, x, m.patch_of(t)[a]);
+    for (int a = 0; a < 12; ++a) p += N[a] * m.entry_position(x, m.patch_of(t)[a]);
     return p;
   };
   for (Index t = 0; t < m.num_triangles(); ++t)
