@@ -32,6 +32,7 @@ struct SubdivisionBasis {
   Vector N, d1, d2, d11, d12, d22;
 };
 
+// clang-format off
 /// Exponents (i, j, k) of u^i v^j w^k, the columns of kLoopRegularCoefficients.
 inline constexpr std::array<std::array<int, 3>, 15> kLoopMonomials = {{
     {4, 0, 0}, {3, 1, 0}, {3, 0, 1}, {2, 2, 0}, {2, 1, 1}, {2, 0, 2}, {1, 3, 0}, {1, 2, 1},
@@ -60,6 +61,8 @@ inline constexpr std::array<std::array<int, 15>, 12> kLoopRegularCoefficients = 
 inline constexpr std::array<std::array<int, 2>, 12> kLoopRegularLattice = {{
     {0, -1}, {-1, 0}, {1, -1}, {0, 0}, {-1, 1}, {2, -1}, {1, 0}, {0, 1}, {-1, 2}, {2, 0}, {1, 1}, {0, 2},
 }};
+
+// clang-format on
 
 namespace detail {
 

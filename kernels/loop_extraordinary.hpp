@@ -54,17 +54,17 @@ Eigen::Matrix<double, N + 12, N + 6> loop_extraordinary_subdivision() {
     S(0, i) = beta;
     edge(i, p, i, i == 1 ? N : i - 1, i == N ? 1 : i + 1);
   }
-  edge(N + 1, b, rN, p, v6);                      // (2,-1)
+  edge(N + 1, b, rN, p, v6);                           // (2,-1)
   regular_vertex(N + 2, b, {c, p, rN, v6, v10, v11});  // (2,0)
-  edge(N + 3, b, c, p, v11);                      // (1,1)
+  edge(N + 3, b, c, p, v11);                           // (1,1)
   regular_vertex(N + 4, c, {p, b, v11, v12, v9, r3});  // (0,2)
-  edge(N + 5, c, r3, p, v9);                      // (-1,2)
-  edge(N + 6, b, v6, rN, v10);                    // (3,-1)
-  edge(N + 7, b, v10, v6, v11);                   // (3,0)
-  edge(N + 8, b, v11, v10, c);                    // (2,1)
-  edge(N + 9, c, v11, b, v12);                    // (1,2)
-  edge(N + 10, c, v9, v12, r3);                   // (-1,3)
-  edge(N + 11, c, v12, v11, v9);                  // (0,3)
+  edge(N + 5, c, r3, p, v9);                           // (-1,2)
+  edge(N + 6, b, v6, rN, v10);                         // (3,-1)
+  edge(N + 7, b, v10, v6, v11);                        // (3,0)
+  edge(N + 8, b, v11, v10, c);                         // (2,1)
+  edge(N + 9, c, v11, b, v12);                         // (1,2)
+  edge(N + 10, c, v9, v12, r3);                        // (-1,3)
+  edge(N + 11, c, v12, v11, v9);                       // (0,3)
   return S;
 }
 
@@ -74,10 +74,12 @@ namespace detail {
 /// of the points listed above).
 template <int N>
 int loop_extended_row(int i, int j) {
+  // clang-format off
   constexpr int table[][3] = {{0, 0, 0},       {1, 0, 1},       {0, 1, 2},       {-1, 1, 3},      {1, -1, N},
                               {2, -1, N + 1},  {2, 0, N + 2},   {1, 1, N + 3},   {0, 2, N + 4},   {-1, 2, N + 5},
                               {3, -1, N + 6},  {3, 0, N + 7},   {2, 1, N + 8},   {1, 2, N + 9},   {-1, 3, N + 10},
                               {0, 3, N + 11}};
+  // clang-format on
   for (const auto& t : table)
     if (t[0] == i && t[1] == j) return t[2];
   SHATTER_ASSERT(false);
@@ -91,8 +93,9 @@ int loop_extended_row(int i, int j) {
 template <int N>
 SubdivisionBasis<N + 6> loop_extraordinary_basis(double v, double w) {
   constexpr int K = N + 6;
-  SHATTER_REQUIRE(v >= 0 && w >= 0 && v + w > 0 && v + w <= 1 + 1e-12,
-                  "loop_extraordinary_basis: (v, w) = (" << v << ", " << w << ") is not in the triangle or is its corner");
+  SHATTER_REQUIRE(
+      v >= 0 && w >= 0 && v + w > 0 && v + w <= 1 + 1e-12,
+      "loop_extraordinary_basis: (v, w) = (" << v << ", " << w << ") is not in the triangle or is its corner");
   const Eigen::Matrix<double, N + 12, K> S = loop_extraordinary_subdivision<N>();
   Eigen::Matrix<double, K, K> C = Eigen::Matrix<double, K, K>::Identity();
   double scale = 2;  // d(parameter of the regular sub-triangle) / d(v, w), up to sign

@@ -47,7 +47,8 @@ struct ShellQuadrature<1> {
 };
 template <>
 struct ShellQuadrature<3> {
-  static constexpr std::array<std::array<double, 2>, 3> point = {{{1.0 / 6, 1.0 / 6}, {2.0 / 3, 1.0 / 6}, {1.0 / 6, 2.0 / 3}}};
+  static constexpr std::array<std::array<double, 2>, 3> point = {
+      {{1.0 / 6, 1.0 / 6}, {2.0 / 3, 1.0 / 6}, {1.0 / 6, 2.0 / 3}}};
   static constexpr std::array<double, 3> weight = {1.0 / 6, 1.0 / 6, 1.0 / 6};
 };
 

@@ -188,8 +188,8 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
     const auto& c = m.triangles[t];
     for (int k = 0; k < 3; ++k) {
       if (c[k] < 0 || c[k] >= n)
-        throw InputError(where + ": triangle " + std::to_string(t) + " names vertex " + std::to_string(c[k]) +
-                         " of " + std::to_string(n));
+        throw InputError(where + ": triangle " + std::to_string(t) + " names vertex " + std::to_string(c[k]) + " of " +
+                         std::to_string(n));
       if (c[k] == c[(k + 1) % 3])
         throw InputError(where + ": triangle " + std::to_string(t) + " repeats vertex " + std::to_string(c[k]));
     }
@@ -198,7 +198,8 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
       const Index p = c[k], q = c[(k + 1) % 3];
       auto& tris = edge_triangles[edge_key(std::min(p, q), std::max(p, q))];
       tris.push_back(t);
-      if (tris.size() > 2) throw InputError(where + ": the edge of " + vertices_named(p, q) + " has 3 or more triangles");
+      if (tris.size() > 2)
+        throw InputError(where + ": the edge of " + vertices_named(p, q) + " has 3 or more triangles");
     }
   }
   for (Index v = 0; v < n; ++v)

@@ -40,7 +40,8 @@ std::map<Point, double> loop_refine(const std::map<Point, double>& f) {
       if (ei && ej) {
         const int i = I / 2, j = J / 2;
         value = 10.0 / 16 * at(i, j) +
-                1.0 / 16 * (at(i + 1, j) + at(i - 1, j) + at(i, j + 1) + at(i, j - 1) + at(i + 1, j - 1) + at(i - 1, j + 1));
+                1.0 / 16 *
+                    (at(i + 1, j) + at(i - 1, j) + at(i, j + 1) + at(i, j - 1) + at(i + 1, j - 1) + at(i - 1, j + 1));
       } else if (!ei && ej) {  // edge along (1, 0) from P
         const int i = (I - 1) / 2, j = J / 2;
         value = 3.0 / 8 * (at(i, j) + at(i + 1, j)) + 1.0 / 8 * (at(i, j + 1) + at(i + 1, j - 1));
@@ -109,7 +110,12 @@ TEST(LoopBasis, CornersTakeTheLoopLimitMask) {
       const int dv = kLoopRegularLattice[a][0] - kLoopRegularLattice[corner[c]][0];
       const int dw = kLoopRegularLattice[a][1] - kLoopRegularLattice[corner[c]][1];
       const bool neighbour = (std::abs(dv) + std::abs(dw) == 1) || (dv == -dw && std::abs(dv) == 1);
-      EXPECT_NEAR(B.N[a], a == corner[c] ? 0.5 : neighbour ? 1.0 / 12 : 0.0, 1e-15) << "corner " << c << " vertex " << a;
+      EXPECT_NEAR(B.N[a],
+                  a == corner[c] ? 0.5
+                  : neighbour    ? 1.0 / 12
+                                 : 0.0,
+                  1e-15)
+          << "corner " << c << " vertex " << a;
     }
   }
 }

@@ -29,9 +29,9 @@ double scaled_difference(const SubdivisionBasis<K>& a, const SubdivisionBasis<K>
 
 /// Points of the triangle, some very near the extraordinary corner.
 std::vector<std::array<double, 2>> sample_points() {
-  std::vector<std::array<double, 2>> pts = {{1.0 / 6, 1.0 / 6}, {2.0 / 3, 1.0 / 6}, {1.0 / 6, 2.0 / 3}, {1.0 / 3, 1.0 / 3},
-                                            {0.01, 0.02},       {1e-4, 3e-5},       {0.3, 0.0},        {0.0, 0.7},
-                                            {0.25, 0.25},       {0.5, 0.5}};
+  std::vector<std::array<double, 2>> pts = {
+      {1.0 / 6, 1.0 / 6}, {2.0 / 3, 1.0 / 6}, {1.0 / 6, 2.0 / 3}, {1.0 / 3, 1.0 / 3}, {0.01, 0.02},
+      {1e-4, 3e-5},       {0.3, 0.0},         {0.0, 0.7},         {0.25, 0.25},       {0.5, 0.5}};
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0, 1);
   for (int t = 0; t < 20; ++t) {
@@ -93,11 +93,11 @@ Eigen::Matrix<double, 3, N + 6> patch_positions() {
     X.col(i) = Vec3(std::cos(a), std::sin(a), 0.1 * std::cos(2 * a));
   }
   const Vec3 b = X.col(1), c = X.col(2), r3 = X.col(3), rN = X.col(N), p = X.col(0);
-  X.col(N + 1) = b + rN - p;      // 6
-  X.col(N + 2) = 2 * b - p;       // 10
-  X.col(N + 3) = b + c - p;       // 11
-  X.col(N + 4) = 2 * c - p;       // 12
-  X.col(N + 5) = c + r3 - p;      // 9
+  X.col(N + 1) = b + rN - p;  // 6
+  X.col(N + 2) = 2 * b - p;   // 10
+  X.col(N + 3) = b + c - p;   // 11
+  X.col(N + 4) = 2 * c - p;   // 12
+  X.col(N + 5) = c + r3 - p;  // 9
   return X;
 }
 
@@ -121,7 +121,8 @@ void check_shell_on_patch() {
       xp(k, a) += h;
       xm(k, a) -= h;
       const double fd = (shell_internal_force<K, 3>(xp, basis, ref, mat).energy -
-                         shell_internal_force<K, 3>(xm, basis, ref, mat).energy) / (2 * h);
+                         shell_internal_force<K, 3>(xm, basis, ref, mat).energy) /
+                        (2 * h);
       EXPECT_NEAR(out.f(k, a), fd, 1e-6 * out.f.norm()) << "N " << N << " vertex " << a;
     }
   const Mat3 R = Eigen::AngleAxisd(1.1, Vec3(0.2, 1, -0.4).normalized()).toRotationMatrix();

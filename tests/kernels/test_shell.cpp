@@ -92,7 +92,8 @@ TEST(Shell, ForceIsEnergyGradientAndBalanced) {
       xp(k, a) += h;
       xm(k, a) -= h;
       const double fd = (shell_internal_force<12, 3>(xp, kBasis, ref, kMat).energy -
-                         shell_internal_force<12, 3>(xm, kBasis, ref, kMat).energy) / (2 * h);
+                         shell_internal_force<12, 3>(xm, kBasis, ref, kMat).energy) /
+                        (2 * h);
       EXPECT_NEAR(out.f(k, a), fd, 1e-6 * out.f.norm()) << "vertex " << a << " component " << k;
     }
   // no net force, no net torque
@@ -137,15 +138,15 @@ TEST(Shell, QuadraticBendingGivesThePlateBendingEnergy) {
   Patch X = flat_patch(l);
   X.colwise() -= X.rowwise().mean();
   const auto ref = shell_reference<12, 3>(X, kBasis, t);
-  for (const auto& k : {std::array{1.0, 1.0, 0.0}, std::array{1.0, -1.0, 0.0}, std::array{0.0, 0.0, 1.0},
-                        std::array{0.5, -0.2, 0.7}}) {
+  for (const auto& k :
+       {std::array{1.0, 1.0, 0.0}, std::array{1.0, -1.0, 0.0}, std::array{0.0, 0.0, 1.0}, std::array{0.5, -0.2, 0.7}}) {
     Patch x = X;
     for (int a = 0; a < 12; ++a) {
       const double px = X(0, a), py = X(1, a);
       x(2, a) = 0.5 * (k[0] * px * px + k[1] * py * py) + k[2] * px * py;
     }
-    const double plate = 0.5 * D *
-                         (k[0] * k[0] + k[1] * k[1] + 2 * kPoisson * k[0] * k[1] + 2 * (1 - kPoisson) * k[2] * k[2]);
+    const double plate =
+        0.5 * D * (k[0] * k[0] + k[1] * k[1] + 2 * kPoisson * k[0] * k[1] + 2 * (1 - kPoisson) * k[2] * k[2]);
     const auto out = shell_internal_force<12, 3>(x, kBasis, ref, kMat);
     EXPECT_CLOSE(out.energy / element_area(ref), plate, 2e-4, 0) << k[0] << " " << k[1] << " " << k[2];
   }
@@ -155,7 +156,8 @@ TEST(Shell, InPlaneStretchGivesTheMembraneEnergy) {
   const double t = 0.002;
   const Patch X = flat_patch(0.05, 0.2);
   const auto ref = shell_reference<12, 3>(X, kBasis, t);
-  for (const auto& [l1, l2] : {std::pair{1.2, 1.0}, std::pair{1.1, 0.9}, std::pair{0.8, 0.7}, std::pair{1.0 + 1e-4, 1.0}}) {
+  for (const auto& [l1, l2] :
+       {std::pair{1.2, 1.0}, std::pair{1.1, 0.9}, std::pair{0.8, 0.7}, std::pair{1.0 + 1e-4, 1.0}}) {
     Patch x = X;
     x.row(0) *= l1;
     x.row(1) *= l2;

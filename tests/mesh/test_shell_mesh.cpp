@@ -32,7 +32,8 @@ ShellMesh lattice(int n, bool flip = false) {
   for (int j = 0; j + 1 < n; ++j)
     for (int i = 0; i + 1 < n; ++i) {
       const bool f = flip && (i + j) % 2 == 1;
-      tris.push_back(f ? std::array{id(i, j), id(i, j + 1), id(i + 1, j)} : std::array{id(i, j), id(i + 1, j), id(i, j + 1)});
+      tris.push_back(f ? std::array{id(i, j), id(i, j + 1), id(i + 1, j)}
+                       : std::array{id(i, j), id(i + 1, j), id(i, j + 1)});
       tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   return build_shell_mesh(std::move(x), std::move(tris), "lattice");
@@ -47,13 +48,21 @@ Vec3 patch_point(const ShellMesh& m, Index t, const Eigen::Matrix<double, K, 1>&
 }
 Vec3 limit_point(const ShellMesh& m, Index t, double v, double w) {
   switch (m.patch_size(t)) {
-    case 12: return patch_point<12>(m, t, loop_regular_basis(v, w).N);
-    case 9: return patch_point<9>(m, t, loop_extraordinary_basis<3>(v, w).N);
-    case 10: return patch_point<10>(m, t, loop_extraordinary_basis<4>(v, w).N);
-    case 11: return patch_point<11>(m, t, loop_extraordinary_basis<5>(v, w).N);
-    case 13: return patch_point<13>(m, t, loop_extraordinary_basis<7>(v, w).N);
-    case 14: return patch_point<14>(m, t, loop_extraordinary_basis<8>(v, w).N);
-    default: ADD_FAILURE() << "valence " << m.patch_size(t) - 6 << " not covered"; return Vec3::Zero();
+    case 12:
+      return patch_point<12>(m, t, loop_regular_basis(v, w).N);
+    case 9:
+      return patch_point<9>(m, t, loop_extraordinary_basis<3>(v, w).N);
+    case 10:
+      return patch_point<10>(m, t, loop_extraordinary_basis<4>(v, w).N);
+    case 11:
+      return patch_point<11>(m, t, loop_extraordinary_basis<5>(v, w).N);
+    case 13:
+      return patch_point<13>(m, t, loop_extraordinary_basis<7>(v, w).N);
+    case 14:
+      return patch_point<14>(m, t, loop_extraordinary_basis<8>(v, w).N);
+    default:
+      ADD_FAILURE() << "valence " << m.patch_size(t) - 6 << " not covered";
+      return Vec3::Zero();
   }
 }
 
@@ -104,7 +113,8 @@ TEST(ShellMesh, LatticePatchesFollowTheLoopBasisOrder) {
       const Vec3 x4 = m.reference[p[3]], e1 = m.reference[p[6]] - x4, e2 = m.reference[p[7]] - x4;
       for (int a = 0; a < 12; ++a)
         EXPECT_LT((m.entry_position(m.reference, p[a]) -
-                   (x4 + kLoopRegularLattice[a][0] * e1 + kLoopRegularLattice[a][1] * e2)).norm(),
+                   (x4 + kLoopRegularLattice[a][0] * e1 + kLoopRegularLattice[a][1] * e2))
+                      .norm(),
                   1e-12)
             << "triangle " << t << " patch vertex " << a;
     }
@@ -125,7 +135,8 @@ TEST(ShellMesh, GhostVerticesKeepContinuityAndMomentumBalance) {
   std::vector<Vec3> X = m.reference;
   for (Vec3& p : X) p.z() = 0.05 * (p.x() * p.x() - p.y() * p.y());
   std::vector<Vec3> x = X;
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] += 0.02 * Vec3(std::sin(3.0 * i), std::cos(5.0 * i), std::sin(7.0 * i));
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] += 0.02 * Vec3(std::sin(3.0 * i), std::cos(5.0 * i), std::sin(7.0 * i));
   const auto basis = loop_regular_basis_at_quadrature<3>();
   const NeoHookean mat = NeoHookean::from_young_poisson(1e9, 0.3, 1000);
   std::vector<Vec3> f(x.size(), Vec3::Zero());
@@ -273,7 +284,8 @@ TEST(ShellMesh, LoopSubdivisionKeepsTheLimitSurfaceAndSeparatesExtraordinaryVert
   EXPECT_EQ(fine.num_vertices(), coarse.num_vertices() + edges / 2);
   ASSERT_EQ(fine.num_triangles(), 4 * coarse.num_triangles());
   int several = 0, compared = 0;
-  for (Index t = 0; t < fine.num_triangles(); ++t) several += fine.patch_kind[t] == ShellPatchKind::several_extraordinary;
+  for (Index t = 0; t < fine.num_triangles(); ++t)
+    several += fine.patch_kind[t] == ShellPatchKind::several_extraordinary;
   EXPECT_EQ(several, 0);
   // Where the coarse triangle has a patch, the limit surface is the same:
   // at its centroid (the centroid of its central sub-triangle 4t + 3) and at
@@ -321,14 +333,15 @@ TEST(ShellMesh, GmshOpenSurfacesHaveBoundaries) {
     std::cout << shape << ": " << supported << " of " << boundary_triangles
               << " boundary triangles completed by ghost vertices\n";
   }
-  EXPECT_NE(input_error([] { mesh_shell_shape({.shape = "cone", .element_size = 0.1}, "bodies[0].mesh"); })
-                .find("bodies[0].mesh.shape: expected one of sphere, disk, rectangle, cylinder"),
+  EXPECT_NE(input_error([] {
+              mesh_shell_shape({.shape = "cone", .element_size = 0.1}, "bodies[0].mesh");
+            }).find("bodies[0].mesh.shape: expected one of sphere, disk, rectangle, cylinder"),
             std::string::npos);
 }
 
 TEST(ShellMesh, BadTriangleMeshesAreRefused) {
-  const std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0), Vec3(0, 0, 1),
-                               Vec3(-1, 0, 0), Vec3(0, -1, 0)};
+  const std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1, 0, 0),  Vec3(0, 1, 0), Vec3(1, 1, 0),
+                               Vec3(0, 0, 1), Vec3(-1, 0, 0), Vec3(0, -1, 0)};
   auto error = [&](std::vector<std::array<Index, 3>> tris, std::vector<Vec3> points) {
     return input_error([&] { build_shell_mesh(std::move(points), std::move(tris), "file.msh"); });
   };
@@ -337,8 +350,9 @@ TEST(ShellMesh, BadTriangleMeshesAreRefused) {
   EXPECT_NE(error({{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, x).find("the edge of vertices 0 and 1 has 3 or more"),
             std::string::npos);
   // two triangles meeting at vertex 0 only (a bow tie)
-  EXPECT_NE(error({{0, 1, 2}, {0, 3, 4}}, {x[0], x[1], x[2], x[5], x[6]}).find("triangles at vertex 0 do not form one fan"),
-            std::string::npos);
+  EXPECT_NE(
+      error({{0, 1, 2}, {0, 3, 4}}, {x[0], x[1], x[2], x[5], x[6]}).find("triangles at vertex 0 do not form one fan"),
+      std::string::npos);
   EXPECT_NE(error({{0, 1, 2}}, x).find("vertex 3 is in no triangle"), std::string::npos);
   // a Moebius strip of 5 quads (10 triangles) is not orientable
   std::vector<Vec3> strip;
@@ -348,7 +362,8 @@ TEST(ShellMesh, BadTriangleMeshesAreRefused) {
     const double a = 2 * std::numbers::pi * i / k;
     for (int s : {-1, 1}) {
       const double h = 0.3 * s;
-      strip.emplace_back((1 + h * std::cos(a / 2)) * std::cos(a), (1 + h * std::cos(a / 2)) * std::sin(a), h * std::sin(a / 2));
+      strip.emplace_back((1 + h * std::cos(a / 2)) * std::cos(a), (1 + h * std::cos(a / 2)) * std::sin(a),
+                         h * std::sin(a / 2));
     }
   }
   for (int i = 0; i < k; ++i) {

@@ -100,7 +100,8 @@ TEST(ShellPlate, SimplySupportedFirstFrequencyConverges) {
   for (int n : {9, 17, 33}) {
     int skipped = 0;
     const ShellMesh m = square_plate(n, a);
-    const double omega = first_frequency(m, t, mat, [&](Index v) { return m.on_boundary[v] != 0; }, skipped);
+    const double omega = first_frequency(
+        m, t, mat, [&](Index v) { return m.on_boundary[v] != 0; }, skipped);
     errors.push_back(omega / exact - 1);
     std::cout << "simply supported plate, " << n - 1 << " x " << n - 1 << " cells: omega " << omega << " (exact "
               << exact << "), error " << errors.back() << ", " << skipped << " corner triangles without a patch\n";
@@ -125,7 +126,8 @@ TEST(ShellPlate, ClampedFirstFrequencyConverges) {
     int skipped = 0;
     ShellMesh m = square_plate(n, a);
     std::fill(m.ghost_mode.begin(), m.ghost_mode.end(), GhostMode::even);
-    const double omega = first_frequency(m, t, mat, [&](Index v) { return m.on_boundary[v] != 0; }, skipped);
+    const double omega = first_frequency(
+        m, t, mat, [&](Index v) { return m.on_boundary[v] != 0; }, skipped);
     errors.push_back(omega / exact - 1);
     std::cout << "clamped plate, " << n - 1 << " x " << n - 1 << " cells: omega " << omega << " (exact " << exact
               << "), error " << errors.back() << "\n";

@@ -21,8 +21,8 @@ namespace {
 /// Icosahedron refined `levels` times by edge midpoints, on the sphere of radius R.
 ShellMesh icosphere(int levels, double R) {
   const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vec3> x = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Vec3> x = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   std::vector<std::array<Index, 3>> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                          {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                                          {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -67,8 +67,8 @@ struct SphereModel {
     mass.assign(m.num_vertices(), 0.0);
     for (Index e = 0; e < m.num_triangles(); ++e) {
       const auto& c = m.triangles[e];
-      dt = std::min(dt, shell_stable_dt(shell_stable_length(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]]),
-                                        t, mat));
+      dt = std::min(
+          dt, shell_stable_dt(shell_stable_length(m.reference[c[0]], m.reference[c[1]], m.reference[c[2]]), t, mat));
       if (m.patch_size(e) == 12)
         add(regular, m, e);
       else if (m.patch_size(e) == 11)
@@ -171,7 +171,7 @@ TEST(ShellSphere, BreathingFrequencyMatchesMembraneTheory) {
     worst_energy = std::max(worst_energy, std::abs(kinetic(model, s) + s.strain - energy0));
     ASSERT_LT(time, 20 * 2 * std::numbers::pi / omega);
   }
-  const double period = 0.5 * (crossings[4] - crossings[0]);  // two periods
+  const double period = 0.5 * (crossings[4] - crossings[0]);    // two periods
   EXPECT_CLOSE(2 * std::numbers::pi / period, omega, 0.01, 0);  // measured -0.32 %
   std::cout << "breathing: omega " << 2 * std::numbers::pi / period << " rad/s, membrane theory " << omega
             << " (R_limit " << R_limit << "), " << period / dt << " steps per period, energy error "
