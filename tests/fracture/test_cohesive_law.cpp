@@ -71,10 +71,17 @@ TEST(CohesiveLaw, StartsAtTheStrengthAndSoftens) {
   EXPECT_EQ(
       cohesive_traction(law, 0.5 * law.delta_c * kNormal, kNormal, past.delta_max).traction.norm(),
       0.0);
-  // Zero opening (the direction is undefined): no traction, no state, no energy.
+  // Zero opening, just inserted (the direction is undefined): sigma_c along
+  // the normal, no state, no energy. Closed by a hair in compression: the
+  // cohesive part is 0, the penalty pushes apart (n = z, so that the shear
+  // part is exactly 0: any shear slip meets the cohesive law, t_0 beta).
   const CohesiveTraction zero = cohesive_traction(law, Vec3::Zero(), kNormal, 0.0);
-  EXPECT_EQ(zero.traction.norm(), 0.0);
+  EXPECT_EQ(zero.traction, law.sigma_c * kNormal);
+  EXPECT_EQ(zero.delta_max, 0.0);
   EXPECT_EQ(zero.stored + zero.dissipated, 0.0);
+  const double hair = -1e-12 * law.delta_c;
+  const CohesiveTraction closed = cohesive_traction(law, Vec3(0, 0, hair), Vec3::UnitZ(), 0.0);
+  EXPECT_EQ(closed.traction, Vec3(0, 0, law.penalty * hair));
 }
 
 TEST(CohesiveLaw, WorkOfSeparationIsGcForEveryMixity) {
