@@ -130,9 +130,9 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
     tbb::parallel_for(
         tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
           for (Index c = r.begin(); c != r.end(); ++c) {
-            const CohesiveLaw* law_ptr = facet_law(mesh, topo, laws, coh.facet[c]);
-            SHATTER_ASSERT(law_ptr);  // insertion happens only where the criterion has a law
-            const CohesiveLaw& law = *law_ptr;
+            const std::optional<CohesiveLaw> law_or = facet_law(mesh, topo, laws, coh.facet[c]);
+            SHATTER_ASSERT(law_or);  // insertion happens only where the criterion has a law
+            const CohesiveLaw& law = *law_or;
             Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
             std::fill(f, f + 2 * k, Vec3::Zero());
             CohesiveEnergy& energy = local_energy[c - first];
@@ -251,7 +251,7 @@ CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveEleme
   CrackArea a;
   for (Index c = 0; c < coh.size(); ++c) {
     const Index f = coh.facet[c];
-    const CohesiveLaw& law = *facet_law(mesh, topo, laws, f);
+    const CohesiveLaw law = *facet_law(mesh, topo, laws, f);
     if (!debonded(coh, c, law)) continue;
     a.debonded += coh.area[c];
     a.debonded_dissipated += law.fracture_energy() * coh.area[c];

@@ -12,12 +12,13 @@
 
 namespace shatter {
 
-const CohesiveLaw* facet_law(const Mesh& mesh, const Topology& topo, FractureLaws laws, Index f) {
+std::optional<CohesiveLaw> facet_law(const Mesh& mesh, const Topology& topo, FractureLaws laws, Index f) {
   const auto [e0, e1] = topo.facet_elem[f];
-  if (e1 < 0) return nullptr;
-  const std::optional<CohesiveLaw>& l0 = laws[mesh.elem_material[e0]];
-  const std::optional<CohesiveLaw>& l1 = laws[mesh.elem_material[e1]];
-  return l0 && l1 ? &*l0 : nullptr;
+  if (e1 < 0) return std::nullopt;
+  const std::optional<CohesiveLaw>& l0 = laws.material[mesh.elem_material[e0]];
+  const std::optional<CohesiveLaw>& l1 = laws.material[mesh.elem_material[e1]];
+  if (!l0 || !l1) return std::nullopt;
+  return laws.facet_strength.empty() ? *l0 : with_strength(*l0, laws.facet_strength[f]);
 }
 
 Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Index e) {
@@ -40,12 +41,13 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
                                       << mesh.num_elements() << " elements");
   const Index ne = mesh.num_elements();
   double weakest = HUGE_VAL, widest = 1.0;  // smallest sigma_c, largest max(1, 1/beta)
-  for (const auto& law : laws)
+  for (const auto& law : laws.material)
     if (law) {
       weakest = std::min(weakest, law->sigma_c);
       widest = std::max(widest, 1.0 / law->beta);
     }
   if (weakest == HUGE_VAL) return {};
+  if (!laws.facet_strength.empty()) weakest = laws.weakest_facet;
   // A cheap exact bound: the effective traction on any plane is at most
   // |t| max(1, 1/beta) <= |sigma|_F max(1, 1/beta), and the facet's stress is
   // the mean of its two elements', so a facet can break only if
@@ -96,7 +98,7 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         // The owner of the smaller element checks the facet (then both are local).
         if (!is_owned(std::min(e, other))) continue;
         if (other < e && frobenius[other] >= hot) continue;  // evaluated from `other`
-        const CohesiveLaw* law = facet_law(mesh, topo, laws, f);
+        const std::optional<CohesiveLaw> law = facet_law(mesh, topo, laws, f);
         if (!law) continue;
         const double wide = std::max(1.0, 1.0 / law->beta);
         if (0.5 * (frobenius[e0] + frobenius[e1]) * wide < law->sigma_c) continue;

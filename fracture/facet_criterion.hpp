@@ -1,5 +1,6 @@
 #pragma once
 // Extrinsic insertion criterion (DESIGN.md step 5): which intact facets break.
+#include <concepts>
 #include <optional>
 #include <span>
 #include <vector>
@@ -9,13 +10,30 @@
 
 namespace shatter {
 
-/// Cohesive law of each material, indexed by Mesh::elem_material; empty for a
-/// material without a `fracture` block (its facets never break).
-using FractureLaws = std::span<const std::optional<CohesiveLaw>>;
+/// The cohesive laws of a mesh.
+struct FractureLaws {
+  /// The materials' laws alone (no scatter): from any contiguous range of them.
+  template <class Laws>
+    requires std::convertible_to<const Laws&, std::span<const std::optional<CohesiveLaw>>>
+  FractureLaws(const Laws& laws) : material(laws) {}  // NOLINT(google-explicit-constructor)
+  FractureLaws(std::span<const std::optional<CohesiveLaw>> laws, std::span<const double> strength,
+               double weakest)
+      : material(laws), facet_strength(strength), weakest_facet(weakest) {}
+
+  /// Law of each material, indexed by Mesh::elem_material; empty for a
+  /// material without a `fracture` block (its facets never break).
+  std::span<const std::optional<CohesiveLaw>> material;
+  /// Strength of each facet of the Topology, Pa (strength scatter,
+  /// fracture/strength_scatter.hpp); empty: every facet has its material's.
+  std::span<const double> facet_strength = {};
+  /// The smallest value of facet_strength, Pa (read only when it is not empty).
+  double weakest_facet = 0;
+};
 
 /// The law of an interior facet: the law of the material of element 0 (the
-/// one of smaller global id) when both adjacent materials fracture, else none.
-const CohesiveLaw* facet_law(const Mesh& mesh, const Topology& topo, FractureLaws laws, Index f);
+/// one of smaller global id) when both adjacent materials fracture, with the
+/// facet's own strength under scatter (same Gc); else none.
+std::optional<CohesiveLaw> facet_law(const Mesh& mesh, const Topology& topo, FractureLaws laws, Index f);
 
 /// Cauchy stress of element e from `stress`, laid out per element as
 /// 6 Voigt components (xx, yy, zz, yz, xz, xy) or 9 row-major components

@@ -1,50 +1,66 @@
 #pragma once
-// Ortiz-Pandolfi cohesive law (M. Ortiz, A. Pandolfi, "Finite-deformation
-// irreversible cohesive elements for three-dimensional crack-propagation
-// analysis", IJNME 44 (1999) 1267-1282, eqs. 20-27), extrinsic form: the
-// element is rigid until inserted, so loading starts at t = sigma_c.
+// Extrinsic Ortiz-Pandolfi cohesive law (G. T. Camacho, M. Ortiz, "Computational
+// modelling of impact damage in brittle materials", IJSS 33 (1996)
+// 2899-2938; M. Ortiz, A. Pandolfi, "Finite-deformation irreversible
+// cohesive elements for three-dimensional crack-propagation analysis", IJNME
+// 44 (1999) 1267-1282, eqs. 20-27): a facet is rigid until the criterion
+// breaks it, and its traction then starts where the facet was, at the
+// strength sigma_c, and softens.
 //
 // With the opening vector Delta (m) split along the unit facet normal n into
 //   delta_n = Delta . n,  delta_s = Delta - delta_n n   (vector),
-// the effective opening is  delta = sqrt(beta^2 |delta_s|^2 + delta_n^2)  and
+// the effective opening is  delta = sqrt(beta^2 |delta_s|^2 + <delta_n>^2)  and
 // the traction (Pa) derives from a potential phi(delta, delta_max):
-//   T = (t / delta) (beta^2 delta_s + delta_n n),
-// so that T . dDelta = t d(delta) along any path. The effective traction is
-//   loading   (delta >= delta_max): t = envelope(delta)
-//   unloading (delta <  delta_max): t = envelope(delta_max) / delta_max * delta
-//                                   (secant to the origin)
-// with the envelope
-//   t = k_p delta                                 for delta <= delta_0,
-//   t = sigma_c (delta_c - delta) / (delta_c - delta_0)  up to delta_c, 0 past it,
-// delta_c = 2 Gc / sigma_c and delta_0 = sigma_c / k_p. The work of separation
-// is the area of this triangle, sigma_c delta_c / 2 = Gc (J/m^2), for every
-// mode mixity. The state is the largest effective opening reached.
+//   T = (t / delta) (beta^2 delta_s + <delta_n> n),
+// so that T . dDelta = t d(delta) along any path. The state is the largest
+// effective opening reached, delta_max. The effective traction is
+//   loading   (delta >= delta_max): t = envelope(delta) = sigma_c <1 - delta / delta_c>,
+//   unloading (delta <  delta_max): t = envelope(delta_max) - K (delta_max - delta),
+//     K = min(k_p, envelope(delta_max) / delta_max)  (0 past delta_c),
+// delta_c = 2 Gc / sigma_c. The work of separation is the area under the
+// envelope, sigma_c delta_c / 2 = Gc (J/m^2), for every mode mixity.
 //
-// The short elastic rise to sigma_c (delta_0 / delta_c = sigma_c^2 / (2 Gc
-// k_p), 2 % on the fine expanding ring and 4 % on the coarse one) replaces the rigid start of the purely
-// extrinsic law, whose secant sigma_c / delta_max is unbounded as
-// delta_max -> 0: a facet that recloses just after insertion then acts as an
-// arbitrarily stiff spring on its nodes, which no time step integrates stably
-// (measured 10-100 x beyond the limit on the fine ring, docs/validation.md).
-// With the rise,
-// every stiffness of the law (secant, the loading branch's transverse part
-// t / delta, the compression penalty) is at most max(1, beta^2) k_p
-// (cohesive_stiffness_bound), which the stable step includes. Insertion stays
-// extrinsic: the facet is rigid until the criterion breaks it.
+// Unloading: Ortiz and Pandolfi unload along the secant to the origin, whose
+// slope sigma_c / delta_max is unbounded as delta_max -> 0: a facet that
+// recloses just after insertion would be an arbitrarily stiff spring, which
+// no time step integrates (measured 10-100 x beyond the stability limit on
+// the fine expanding ring, docs/validation.md). Here the unloading slope K is
+// the secant where the secant is at most k_p (delta_max >= delta_u =
+// sigma_c / (k_p + sigma_c / delta_c)), so the law is Ortiz-Pandolfi's
+// there, and k_p below: a facet unloaded from a small delta_max still pulls
+// with t_0 = envelope(delta_max) - K delta_max > 0 at delta = 0, as it did
+// at insertion. So the traction is the sum of
+//   (i)  a linear part K (beta^2 delta_s + <delta_n> n), of stiffness at most
+//        max(1, beta^2) k_p, plus the penalty k_p in compression: the
+//        stiffness the stable step includes (cohesive_stiffness_bound);
+//   (ii) a part of bounded size, |T_ii| <= max(1, beta) sigma_c: t_0 along
+//        the opening direction on unloading, the softening envelope on
+//        loading. A bounded force cannot grow a solution exponentially: near
+//        delta = 0 it makes the two sides chatter by at most about
+//        sigma_c A dt^2 / m (A the facet's area, m its nodes' mass), the
+//        elastic opening at the strength, and on loading it acts over an
+//        opening of at most delta_c and releases at most Gc per unit area.
+// At Delta = 0 (a facet just inserted: its two sides coincide) the direction
+// of the opening is undefined; the traction is t_0 n, the subgradient of the
+// cone phi ~ t_0 delta along the normal: the facet pulls with the strength
+// it broke at, so the bulk's work on the first opening is taken out as the
+// law's dissipation counts it (with 0 there, the ledger gained sigma_c
+// delta_1 per unit area at every insertion, delta_1 the first step's
+// opening: +0.6 % of the external work on the alumina bar). Closed in
+// compression (Delta = delta_n n, delta_n < 0) the cohesive part is 0.
 //
 // Compression (delta_n < 0): the cohesive law acts on the shear part only
 // (delta = beta |delta_s|) and interpenetration is resisted by a linear normal
-// penalty T_n = k_p delta_n n with the same stiffness k_p (Pa/m), e.g. E / h.
-// This is a choice of this code: contact (DCR) will also act on crack faces
-// once they are in the contact surface, the penalty only keeps the two sides
-// of a closed crack apart between contact sweeps.
+// penalty T_n = k_p delta_n n with the same stiffness k_p (Pa/m): k_p = E / h
+// (runtime/fracture_stage.cpp), as stiff as the adjacent elements, not a
+// user knob. Crack faces that part meet through contact (DCR) once freed.
 //
 // Energies per unit reference area (J/m^2):
-//   stored     = 1/2 (t(delta_max) / delta_max) delta^2 + 1/2 k_p <-delta_n>^2
-//                (recoverable: the area under the secant, plus the penalty)
-//   dissipated = W(delta_max) - 1/2 t(delta_max) delta_max
-//              = (sigma_c delta_max - t(delta_max) delta_0) / 2 past delta_0
-//                (0 on the elastic rise), Gc once delta_max >= delta_c,
+//   stored     = t_0 delta + K delta^2 / 2 + k_p <-delta_n>^2 / 2
+//                (recoverable: the area under the unloading line, plus the penalty)
+//   dissipated = W(delta_max) - stored(delta_max)
+//              = (sigma_c / delta_c + K) delta_max^2 / 2 before delta_c
+//                (sigma_c delta_max / 2 on the secant branch), Gc past it,
 // where W(delta_max) is the area under the envelope up to delta_max.
 #include <algorithm>
 #include <cmath>
@@ -54,49 +70,48 @@
 
 namespace shatter {
 
-/// Parameters of the Ortiz-Pandolfi law. Build with `make_cohesive_law`.
+/// Parameters of the extrinsic Ortiz-Pandolfi law. Build with `make_cohesive_law`.
 struct CohesiveLaw {
   double sigma_c = 0;  ///< cohesive strength, Pa
   double delta_c = 0;  ///< critical effective opening 2 Gc / sigma_c, m
   double beta = 1;     ///< shear-to-normal weighting, dimensionless
-  double penalty = 0;  ///< k_p, Pa/m: slope of the elastic rise and normal stiffness in compression
+  double penalty = 0;  ///< k_p, Pa/m: the steepest unloading slope and the normal stiffness in compression
 
   /// Fracture energy Gc = sigma_c delta_c / 2, J/m^2.
   double fracture_energy() const { return 0.5 * sigma_c * delta_c; }
-  /// End of the elastic rise, delta_0 = sigma_c / k_p, m.
-  double delta_0() const { return sigma_c / penalty; }
 };
 
-/// sigma_c (Pa), Gc (J/m^2), beta (-), penalty k_p (Pa/m). Requires
-/// delta_0 = sigma_c / k_p < delta_c = 2 Gc / sigma_c.
+/// sigma_c (Pa), Gc (J/m^2), beta (-), penalty k_p (Pa/m), all positive; any
+/// such values make a law.
 inline CohesiveLaw make_cohesive_law(double sigma_c, double fracture_energy, double beta,
                                      double penalty) {
-  const CohesiveLaw law{sigma_c, 2.0 * fracture_energy / sigma_c, beta, penalty};
-  SHATTER_REQUIRE(law.delta_0() < law.delta_c,
-                  "cohesive law: the elastic rise sigma_c / k_p = "
-                      << law.delta_0() << " m must end before delta_c = 2 Gc / sigma_c = "
-                      << law.delta_c << " m (raise Gc or the penalty k_p)");
-  return law;
+  SHATTER_ASSERT(sigma_c > 0 && fracture_energy > 0 && beta > 0 && penalty > 0);
+  return CohesiveLaw{sigma_c, 2.0 * fracture_energy / sigma_c, beta, penalty};
 }
 
-/// Effective traction on the loading envelope, Pa: k_p delta up to delta_0,
-/// then sigma_c (delta_c - delta) / (delta_c - delta_0), 0 past delta_c.
+/// The same law with another strength and the same Gc (delta_c = 2 Gc / sigma_c):
+/// a facet's own strength under strength scatter.
+inline CohesiveLaw with_strength(const CohesiveLaw& law, double sigma_c) {
+  return make_cohesive_law(sigma_c, law.fracture_energy(), law.beta, law.penalty);
+}
+
+/// Effective traction on the loading envelope, Pa: sigma_c (1 - delta / delta_c), 0 past delta_c.
 inline double cohesive_envelope(const CohesiveLaw& law, double delta) {
-  const double d0 = law.delta_0();
-  if (delta <= d0) return law.penalty * delta;
-  return law.sigma_c * std::max(0.0, (law.delta_c - delta) / (law.delta_c - d0));
+  return law.sigma_c * std::max(0.0, 1.0 - delta / law.delta_c);
 }
 
-/// Secant t(delta) / delta of the envelope, Pa/m: k_p on the elastic rise
-/// (also the limit at delta = 0), so never above k_p.
-inline double cohesive_secant(const CohesiveLaw& law, double delta) {
-  return delta <= law.delta_0() ? law.penalty : cohesive_envelope(law, delta) / delta;
+/// Unloading slope from state delta_max, Pa/m: min(k_p, envelope / delta_max)
+/// (k_p at delta_max = 0), 0 past delta_c.
+inline double cohesive_unloading_stiffness(const CohesiveLaw& law, double delta_max) {
+  if (delta_max >= law.delta_c) return 0.0;
+  const double t = cohesive_envelope(law, delta_max);
+  return t < law.penalty * delta_max ? t / delta_max : law.penalty;
 }
 
-/// Upper bound of the norm of dT/dDelta over every state and opening, Pa/m:
-/// max(1, beta^2) k_p (secants, the loading branch's transverse stiffness
-/// t / delta and the compression penalty are all at most this; the loading
-/// branch's own slope is -sigma_c / (delta_c - delta_0), smaller in size).
+/// Upper bound of the stiffness of the linear part (i) of the traction, Pa/m:
+/// max(1, beta^2) k_p (the unloading slope K in every direction, and the
+/// compression penalty). The rest of the traction is bounded by
+/// max(1, beta) sigma_c (see the top of this file).
 inline double cohesive_stiffness_bound(const CohesiveLaw& law) {
   return std::max(1.0, law.beta * law.beta) * law.penalty;
 }
@@ -116,7 +131,7 @@ struct CohesiveTraction {
   double dissipated;  ///< dissipated energy density up to delta_max, J/m^2
 };
 
-/// Ortiz-Pandolfi traction for opening `opening` = x(side 1) - x(side 0) (m),
+/// Traction of the law for opening `opening` = x(side 1) - x(side 0) (m),
 /// unit normal `n` pointing from side 0 to side 1, previous state
 /// `delta_max` (m). Pure; the caller stores the returned state.
 inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& opening,
@@ -128,10 +143,17 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   const double delta = std::sqrt(beta2 * delta_s.squaredNorm() + open_n * open_n);
 
   CohesiveTraction out;
-  out.delta_max = std::max(delta, delta_max);
-  const double t_over_delta = cohesive_secant(law, out.delta_max);  // Pa/m
+  const double dm = std::max(delta, delta_max);
+  out.delta_max = dm;
+  const double K = cohesive_unloading_stiffness(law, dm);
+  const double t0 = dm < law.delta_c ? cohesive_envelope(law, dm) - K * dm : 0.0;  // t at delta = 0
+  const double t = t0 + K * delta;  // Pa; the envelope itself on loading (delta = dm)
+  const double t_over_delta = delta > 0 ? t / delta : 0.0;
   out.traction = t_over_delta * (beta2 * delta_s + open_n * n);
-  out.stored = 0.5 * t_over_delta * delta * delta;
+  // Closed (Delta = 0: a facet just inserted, its sides still together): t_0
+  // along the normal, the traction it carried at the strength.
+  if (delta_n == 0 && delta == 0) out.traction = t0 * n;
+  out.stored = delta * (t0 + 0.5 * K * delta);
   // phi(Delta, n) depends on n through delta_n = Delta . n and |delta_s|^2 =
   // |Delta|^2 - delta_n^2: dphi/dn = (t/delta (<delta_n> - beta^2 delta_n)
   // + k_p min(delta_n, 0)) Delta.
@@ -142,11 +164,8 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
     c += law.penalty * delta_n;
   }
   out.dphi_dn = c * opening;
-  const double dm = out.delta_max;
   out.dissipated = dm >= law.delta_c ? law.fracture_energy()
-                   : dm <= law.delta_0()
-                       ? 0.0
-                       : 0.5 * (law.sigma_c * dm - cohesive_envelope(law, dm) * law.delta_0());
+                                     : 0.5 * (law.sigma_c / law.delta_c + K) * dm * dm;
   return out;
 }
 

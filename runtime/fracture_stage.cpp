@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "fracture/facet_criterion.hpp"
+#include "fracture/strength_scatter.hpp"
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 
@@ -12,32 +14,72 @@ namespace shatter {
 
 FractureStage::FractureStage(Model& model) : model_(model), topology_(build_topology(model.mesh)) {
   const Mesh& mesh = model.mesh;
-  std::vector<double> h_min(model.scene.materials.size(), HUGE_VAL);
+  const size_t nm = model.scene.materials.size();
+  std::vector<double> h_min(nm, HUGE_VAL);
   for (Index e = 0; e < mesh.num_elements(); ++e) {
     const Index* c = mesh.element(e);
     const auto& X = mesh.reference;
     h_min[mesh.elem_material[e]] =
         std::min(h_min[mesh.elem_material[e]], tet_min_altitude(X[c[0]], X[c[1]], X[c[2]], X[c[3]]));
   }
-  for (size_t m = 0; m < model.scene.materials.size(); ++m) {
+  std::vector<std::optional<StrengthScatter>> scatter(nm);
+  for (size_t m = 0; m < nm; ++m) {
     const MaterialSpec& ms = model.scene.materials[m];
-    if (ms.fracture)
+    if (ms.fracture) {
       laws_.emplace_back(make_cohesive_law(ms.fracture->strength, ms.fracture->energy, ms.fracture->beta,
                                            ms.young / h_min[m]));
-    else
+      scatter[m] = ms.fracture->scatter;
+    } else {
       laws_.emplace_back(std::nullopt);
+    }
   }
+  if (std::any_of(scatter.begin(), scatter.end(), [](const auto& s) { return s.has_value(); })) {
+    facet_strength_ = facet_strengths(mesh, topology_, laws_, scatter);
+    weakest_facet_ = *std::min_element(facet_strength_.begin(), facet_strength_.end());
+  }
+}
+
+std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
+  const Mesh& mesh = model_.mesh;
+  const size_t nm = model_.scene.materials.size();
+  std::vector<double> edge_sum(nm, 0.0);
+  std::vector<Index> count(nm, 0);
+  for (Index e = 0; e < mesh.num_elements(); ++e) {
+    const Index* c = mesh.element(e);
+    double longest = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b)
+        longest = std::max(longest, (mesh.reference[c[a]] - mesh.reference[c[b]]).norm());
+    edge_sum[mesh.elem_material[e]] += longest;
+    ++count[mesh.elem_material[e]];
+  }
+  std::vector<std::string> out;
+  for (size_t m = 0; m < nm; ++m) {
+    const MaterialSpec& ms = model_.scene.materials[m];
+    if (!ms.fracture || count[m] == 0) continue;
+    const double h = edge_sum[m] / count[m];
+    const double l_cz = ms.young * ms.fracture->energy / (ms.fracture->strength * ms.fracture->strength);
+    if (l_cz >= kCohesiveZoneElements * h) continue;
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "warning: %s: materials.%s.fracture: the cohesive zone E Gc / sigma_c^2 = %.3e m is shorter "
+                  "than %d elements (mean longest edge h = %.3e m): the mesh does not resolve it, cracks "
+                  "snap through an element at a time and crack paths and fragment sizes depend on the mesh",
+                  model_.scene.file.c_str(), ms.name.c_str(), l_cz, kCohesiveZoneElements, h);
+    out.emplace_back(buf);
+  }
+  return out;
 }
 
 CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3> f_int) {
   if (cohesive_.size() == 0) return {};
-  return cohesive_forces(model_.mesh, topology_, cohesive_, laws_, x, f_int);
+  return cohesive_forces(model_.mesh, topology_, cohesive_, laws(), x, f_int);
 }
 
 std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6,
                                         std::span<const Index> local, std::span<const Index> owned) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws_, local, owned);
+  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws(), local, owned);
   check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return critical;
 }
@@ -63,7 +105,7 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
   if (cohesive_.size() == 0) return element_dt;
   const std::array<Index, 3> key = {cohesive_.size(), model_.mesh.num_nodes(), released_};
   if (key != bound_key_) {
-    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws_, mass);
+    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws(), mass);
     bound_key_ = key;
   }
   const double omega_e = 2.0 / element_dt;
@@ -72,7 +114,7 @@ double FractureStage::stable_dt(double element_dt, std::span<const double> mass)
 
 Index FractureStage::release(std::span<const Vec3> x) {
   if (cohesive_.size() == 0) return 0;
-  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws_, x);
+  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws(), x);
   released_ += freed;  // freed facets exert no force: the eigenvalue bound's key changes
   if (freed > 0) ++facet_revision_;
   return freed;

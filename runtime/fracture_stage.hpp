@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "fracture/cohesive_elements.hpp"
@@ -44,11 +45,22 @@ struct FractureState {
 
 class FractureStage {
  public:
-  /// The penalty of each material's cohesive law (slope of the elastic rise
-  /// and normal stiffness in compression) is k_p = E / h_min (h_min: smallest
-  /// element altitude of that material), as stiff as the adjacent elements;
-  /// stable_dt() accounts for it.
+  /// The penalty of each material's cohesive law (the steepest unloading
+  /// slope and the normal stiffness in compression) is k_p = E / h_min
+  /// (h_min: smallest element altitude of that material), as stiff as the
+  /// adjacent elements, not a user knob; stable_dt() accounts for it. With
+  /// strength scatter, each facet's strength is drawn here from its global id
+  /// (facet_strengths).
   explicit FractureStage(Model& model);
+
+  /// Elements the cohesive zone should span at least (Falk, Needleman & Rice,
+  /// J. Phys. IV 11 (2001) Pr5-43: 2-5 elements for converged crack speeds).
+  static constexpr int kCohesiveZoneElements = 3;
+  /// One warning per fracturing material whose cohesive zone length
+  /// l_cz = E Gc / sigma_c^2 (Rice's estimate up to a factor of order 1) is
+  /// shorter than kCohesiveZoneElements x its mean longest element edge h,
+  /// with both lengths; the run goes on.
+  std::vector<std::string> cohesive_zone_warnings() const;
 
   /// Adds cohesive forces dE/dx at positions x to f_int; returns the energies.
   CohesiveEnergy add_forces(std::span<const Vec3> x, std::span<Vec3> f_int);
@@ -89,10 +101,10 @@ class FractureStage {
   Index cohesive_count() const { return cohesive_.size(); }
   /// The crack surface (crack_area) with the fragments `frags` of the current state.
   CrackArea crack_area(const Fragments& frags) const {
-    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws_, frags.elem_fragment);
+    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws(), frags.elem_fragment);
   }
   /// Per element damage in [0, 1] (element_damage), for output.
-  std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws_); }
+  std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws()); }
 
   /// Copies the fracture state into `state`, reusing its storage; the mesh
   /// and per-node model arrays only when the mesh changed since `state` was
@@ -110,6 +122,9 @@ class FractureStage {
   Topology topology_;
   CohesiveElements cohesive_;
   std::vector<std::optional<CohesiveLaw>> laws_;
+  std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
+  double weakest_facet_ = 0;            ///< min of facet_strength_, Pa
+  FractureLaws laws() const { return {laws_, facet_strength_, weakest_facet_}; }
   double check_seconds_ = 0;
   long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
   mutable Fragments labels_;

@@ -233,6 +233,28 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
   return s;
 }
 
+StrengthScatter strength_scatter(const Reader& r, const YAML::Node& n, const std::string& key) {
+  r.only_keys(n, key, {"distribution", "modulus", "spread", "seed", "reference_area"});
+  StrengthScatter s;
+  const std::string d = r.string(r.required(n, key, "distribution"), key + ".distribution");
+  if (d == "weibull") {
+    s.distribution = ScatterDistribution::weibull;
+    s.modulus = r.positive(r.required(n, key, "modulus"), key + ".modulus");
+    // Below 1 the draws span hundreds of decades (measured moduli are 3-50).
+    if (s.modulus < 1) r.fail(key + ".modulus", "a Weibull modulus >= 1", n["modulus"]);
+  } else if (d == "uniform") {
+    s.distribution = ScatterDistribution::uniform;
+    s.spread = r.number(r.required(n, key, "spread"), key + ".spread");
+    if (!(s.spread >= 0 && s.spread < 1))
+      r.fail(key + ".spread", "a half-width in [0, 1) as a fraction of the strength", n["spread"]);
+  } else {
+    r.fail(key + ".distribution", "one of weibull, uniform", n["distribution"]);
+  }
+  if (n["seed"]) s.seed = static_cast<std::uint64_t>(r.count(n["seed"], key + ".seed", 0));
+  if (n["reference_area"]) s.reference_area = r.positive(n["reference_area"], key + ".reference_area");
+  return s;
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
@@ -327,11 +349,12 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     }
     if (const YAML::Node f = n["fracture"]) {
       const std::string fk = key + ".fracture";
-      r.only_keys(f, fk, {"strength", "energy", "beta"});
+      r.only_keys(f, fk, {"strength", "energy", "beta", "scatter"});
       FractureSpec fs;
       fs.strength = r.positive(r.required(f, fk, "strength"), fk + ".strength");
       fs.energy = r.positive(r.required(f, fk, "energy"), fk + ".energy");
       if (f["beta"]) fs.beta = r.positive(f["beta"], fk + ".beta");
+      if (f["scatter"]) fs.scatter = strength_scatter(r, f["scatter"], fk + ".scatter");
       m.fracture = fs;
     }
     s.materials.push_back(m);

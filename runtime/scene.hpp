@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fracture/strength_scatter.hpp"
 #include "kernels/dcr.hpp"
 #include "kernels/types.hpp"
 #include "mesh/gmsh_input.hpp"
@@ -18,6 +19,7 @@ struct FractureSpec {
   double strength = 0;  ///< sigma_c, Pa
   double energy = 0;    ///< Gc, J/m^2
   double beta = 1.0;    ///< shear/normal strength ratio
+  std::optional<StrengthScatter> scatter;  ///< per-facet strength (fracture.scatter)
 };
 
 struct MaterialSpec {

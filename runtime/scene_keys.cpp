@@ -71,6 +71,14 @@ std::string physics_keys(const Scene& s) {
       w.number(key + ".fracture.strength", m.fracture->strength);
       w.number(key + ".fracture.energy", m.fracture->energy);
       w.number(key + ".fracture.beta", m.fracture->beta);
+      if (const auto& sc = m.fracture->scatter) {
+        const std::string sk = key + ".fracture.scatter";
+        const bool weibull = sc->distribution == ScatterDistribution::weibull;
+        w.text(sk + ".distribution", weibull ? "weibull" : "uniform");
+        w.number(sk + (weibull ? ".modulus" : ".spread"), weibull ? sc->modulus : sc->spread);
+        w.text(sk + ".seed", std::to_string(sc->seed));
+        if (weibull) w.number(sk + ".reference_area", sc->reference_area);
+      }
     }
   }
   for (const BodySpec& b : s.bodies) {

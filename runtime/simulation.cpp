@@ -72,6 +72,8 @@ Simulation::Simulation(Model& model, RunOptions options)
   if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && dec_->rank() == 0)
     std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
                  model_.scene.file.c_str(), *model_.scene.fixed_dt, stable_dt_);
+  if (fracture_ && dec_->rank() == 0)
+    for (const std::string& w : fracture_->cohesive_zone_warnings()) std::fprintf(stderr, "%s\n", w.c_str());
 }
 
 Simulation::~Simulation() = default;

@@ -308,22 +308,28 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
 
 TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
   // The stiffness K of the cohesive forces by central differences on two
-  // elements joined by one cohesive facet, opened a little (on the elastic
-  // rise, in tension and in compression): the largest eigenvalue of
-  // M^-1/2 K M^-1/2 stays below cohesive_eigenvalue_bound, which the stable
-  // step adds to the elements' omega^2, and the bound is not loose.
+  // elements joined by one cohesive facet, unloading from delta_max =
+  // delta_u, where the unloading slope is k_p and the bounded part of the
+  // traction vanishes (kernels/cohesive.hpp), in tension and in compression:
+  // the largest eigenvalue of M^-1/2 K M^-1/2 stays below
+  // cohesive_eigenvalue_bound, which the stable step adds to the elements'
+  // omega^2, and the bound is not loose.
   for_each_joined_pair([](Mesh& m, Topology& t, CohesiveElements& coh, const CohesiveLaw& law,
                           FractureLaws laws, double sign) {
     const std::vector<double> mass = test::lumped_masses(m, 1000.0);
     const double bound = cohesive_eigenvalue_bound(m, t, coh, laws, mass);
-    // Open side 1 by a fraction of delta_0 along a mixed direction.
+    // A state just past delta_u (secant K = envelope / delta_max = k_p to
+    // round-off, t(0) = 0), then side 1 opened by a fraction of it along a
+    // mixed direction.
+    const double delta_u = law.sigma_c / (law.penalty + law.sigma_c / law.delta_c) * (1 + 1e-9);
+    std::fill(coh.delta_max.begin(), coh.delta_max.end(), delta_u);
     std::vector<Vec3> x = m.reference;
     const int k = m.order == 1 ? 3 : 6;
     for (int j = 0; j < k; ++j)
-      x[coh.side_nodes[6 + j]] += 0.2 * law.delta_0() * Vec3(0.3, -0.2, -sign);
+      x[coh.side_nodes[6 + j]] += 0.2 * delta_u * Vec3(0.3, -0.2, -sign);
     const Index ndof = 3 * m.num_nodes();
     Eigen::MatrixXd K(ndof, ndof);
-    const double h = 1e-4 * law.delta_0();
+    const double h = 1e-4 * delta_u;
     for (Index d = 0; d < ndof; ++d) {
       std::vector<Vec3> xp = x, xm = x, fp(m.num_nodes(), Vec3::Zero()),
                         fm(m.num_nodes(), Vec3::Zero());

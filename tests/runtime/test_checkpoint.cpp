@@ -418,6 +418,20 @@ TEST(Checkpoint, RestoredFracturingRunIsBitwiseTheUninterruptedOne) {
   EXPECT_GT(at_end.fragments, 1);
 }
 
+// The same ring with Weibull strength scatter (issue 19): the strengths are
+// drawn again from the facet ids when the restored run builds its model, so
+// it continues bitwise with nothing more in the checkpoint.
+TEST(Checkpoint, RestoredFracturingRunWithWeibullScatterIsBitwiseTheUninterruptedOne) {
+  std::string yaml = ring_scene("ckpt_ring_weibull");
+  const std::string law = "beta: 1.0}";
+  yaml.replace(yaml.find(law), law.size(), "beta: 1.0, scatter: {distribution: weibull, modulus: 6, seed: 2}}");
+  FractureProgress at_checkpoint, at_end;
+  expect_bitwise_continuation("ckpt_ring_weibull", yaml, kRingCheckpointStep, kRingMoreSteps, nullptr,
+                              &at_checkpoint, &at_end);
+  EXPECT_GT(at_checkpoint.cohesive, 0) << "no crack before the checkpoint: move it later";
+  EXPECT_GT(at_end.cohesive, at_checkpoint.cohesive) << "no crack after the checkpoint: run longer";
+}
+
 /// A small brittle pellet (2 mm cube of 100 tets, glass-like, sigma_c = 50
 /// MPa) thrown at `speed` m/s onto a held steel plate (1 um apart). At 20 m/s
 /// it hits in step 3, cracks from step 5 while in contact, the crack faces
