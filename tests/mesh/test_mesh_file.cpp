@@ -56,9 +56,11 @@ const std::vector<Variant> kVariants = {{"v41_ascii.msh"},
 
 /// A cylinder (radius 0.5, length 1) minus a coaxial hole (radius 0.2):
 /// curved faces outside and in, one physical volume 'body'. Written by Gmsh
-/// in every variant; returns the folder.
+/// in every variant; returns the folder, one per test (ctest runs the tests
+/// of this file side by side: a shared folder was rewritten under a reader).
 fs::path write_every_variant(int order) {
-  const fs::path dir = scratch("mesh_file_formats_o" + std::to_string(order));
+  const fs::path dir = scratch("mesh_file_formats_o" + std::to_string(order) + "_" +
+                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
   GmshSession session;
   gmsh::model::add("tube");
   const int outer = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, 1, 0.5);

@@ -96,11 +96,15 @@ TEST(StrictInput, StopDuringSetUpSaysSo) {
   const fs::path dir = scratch_dir("strict_stop");
   const std::string scene = write_scene("strict_stop", kGood);
   for (int sig : {SIGTERM, SIGINT}) {
+    fs::remove_all(dir / "out");
     const fs::path log = dir / "log.txt";
     const shatter::test::Child c = shatter::test::start_shatter(
         {"run", scene, "--quiet", "--out", (dir / "out").string(), "--set", "bodies[0].mesh.element_size=0.0002"},
         log);
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    // In set-up once the output folder is made (before the meshing); under
+    // load the process may take a while to get there.
+    for (int i = 0; i < 600 && !fs::exists(dir / "out"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
     kill(c.pid, sig);
     EXPECT_EQ(shatter::test::finish(c), 1);
     EXPECT_EQ(file_bytes(log), "error: stopped by signal " + std::to_string(sig) + (sig == SIGINT ? " (SIGINT)" : " (SIGTERM)") +
