@@ -131,14 +131,14 @@ else
   per_rank=${3:-2000}
   max_ranks=${4:-64}
   out="$here/results/mpi_scaling_weak.csv"
-  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_memory_rank0" > "$out"
+  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB" > "$out"
   r=1
   while [ "$r" -le "$max_ranks" ]; do
     h=$(size_for $((per_rank * r)))
     dir="$work/weak$r"
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
       --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
-    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(key "$dir" peak_memory_bytes)" | tee -a "$out"
+    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
     r=$((r * 2))
   done
 fi
