@@ -235,6 +235,43 @@ struct Reader {
   std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected) const {
     return array<Vec3>(group, name, expected, 3);
   }
+  /// The rows `keep` (ascending) of a dataset of `expected` Vec3 rows, read
+  /// block by block: the whole dataset's hash is checked, and memory holds
+  /// one block and the kept rows (a part's rows of a whole-model array).
+  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected, std::span<const Index> keep) const {
+    H5Handle dset(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
+    require(dset.valid(),
+            std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
+    H5Handle space(H5Dget_space(dset.get()), H5Sclose);
+    std::array<hsize_t, 2> dims{0, 0};
+    require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
+                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == 3 &&
+                dims[0] == expected,
+            std::string("dataset ") + name + " has the wrong shape (expected " + std::to_string(expected) +
+                " x 3)");
+    constexpr hsize_t kBlock = 1 << 16;
+    std::vector<Vec3> block, out;
+    out.reserve(keep.size());
+    std::uint64_t h = fnv1a(nullptr, 0);
+    size_t k = 0;
+    for (hsize_t first = 0; first < expected; first += kBlock) {
+      const std::array<hsize_t, 2> start{first, 0}, count{std::min<hsize_t>(kBlock, expected - first), 3};
+      block.resize(count[0]);
+      H5Handle memory(H5Screate_simple(2, count.data(), nullptr), H5Sclose);
+      require(memory.valid() &&
+                  H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr) >= 0 &&
+                  H5Dread(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, block.data()) >= 0,
+              std::string("cannot read dataset ") + name + " (truncated or corrupted checkpoint?)");
+      h = fnv1a(block.data(), block.size() * sizeof(Vec3), h);
+      for (; k < keep.size() && static_cast<hsize_t>(keep[k]) < first + count[0]; ++k)
+        out.push_back(block[keep[k] - first]);
+    }
+    require(k == keep.size(), std::string("dataset ") + name + " has fewer rows than the model");
+    std::uint64_t stored = 0;
+    attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &stored);
+    require(stored == h, std::string("dataset ") + name + " fails its hash check (corrupted checkpoint)");
+    return out;
+  }
 };
 
 template <class... Arrays>
@@ -506,12 +543,23 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   std::size_t b = 0;
   if (model.is_part() && !s.fracture) b = model.part.whole_bc_nodes;
   else for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
-  s.x = r.rows(state.get(), "positions", n);
-  s.v = r.rows(state.get(), "velocities", n);
-  s.a = r.rows(state.get(), "accelerations", n);
-  s.f_int = r.rows(state.get(), "internal_forces", n);
-  s.f_ext = r.rows(state.get(), "external_forces", n);
-  s.reaction = r.rows(state.get(), "reactions", b);
+  if (model.is_part() && !s.fracture) {
+    // A part reads its own rows (the whole state never in memory).
+    const std::span<const Index> nodes = model.part.node_index;
+    s.x = r.rows(state.get(), "positions", n, nodes);
+    s.v = r.rows(state.get(), "velocities", n, nodes);
+    s.a = r.rows(state.get(), "accelerations", n, nodes);
+    s.f_int = r.rows(state.get(), "internal_forces", n, nodes);
+    s.f_ext = r.rows(state.get(), "external_forces", n, nodes);
+    s.reaction = r.rows(state.get(), "reactions", b, model.part.bc_index);
+  } else {
+    s.x = r.rows(state.get(), "positions", n);
+    s.v = r.rows(state.get(), "velocities", n);
+    s.a = r.rows(state.get(), "accelerations", n);
+    s.f_int = r.rows(state.get(), "internal_forces", n);
+    s.f_ext = r.rows(state.get(), "external_forces", n);
+    s.reaction = r.rows(state.get(), "reactions", b);
+  }
 
   H5Handle ledger(H5Gopen2(root, "ledger", H5P_DEFAULT), H5Gclose);
   r.require(ledger.valid(), "group /ledger is missing (truncated or corrupted checkpoint?)");

@@ -93,7 +93,10 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 /// Also refuses a scene whose physics (physics_keys(): materials, bodies,
 /// boundary conditions, contact, gravity, ...) differs from the checkpoint's,
 /// naming the first key that differs. `run`, when given, receives what the
-/// checkpoint says of the run that wrote it.
+/// checkpoint says of the run that wrote it. A part of the model
+/// (Model::is_part) gets its own nodes' rows and reactions, read block by
+/// block with every dataset's hash still checked: the whole state is never
+/// in a rank's memory.
 struct CheckpointRun {
   long history_every = 0;  ///< output.history_every of that run; 0: not recorded (version 2)
 };

@@ -116,8 +116,8 @@ class Simulation {
 
   /// Copies the state between two steps into `state` (reusing its storage).
   void save_state(SimulationState& state) const;
-  /// Continues from `state` (of this model; on a part of the model, the whole
-  /// model's state, as a checkpoint holds it): the next
+  /// Continues from `state` (of this model; on a part of the model, the
+  /// part's rows, as read_checkpoint gives them): the next
   /// step() is the one the saved run would have taken, bitwise, and run()
   /// appends to the outputs in opt.out_dir (checkpoint.hpp). Throws Error when
   /// the array sizes do not match the model.
@@ -173,8 +173,6 @@ class Simulation {
   /// several ranks) to `path` from rank 0; collective; throws Error on every
   /// rank when the write fails.
   void save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason = "");
-  /// restore_state on a part of the model: `s` is the whole model's state.
-  void restore_part(const SimulationState& s);
   /// restore_state's step, time, controller and ledger.
   void restore_scalars(const SimulationState& s);
   /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.

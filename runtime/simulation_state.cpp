@@ -85,7 +85,6 @@ void Simulation::restore_state(const SimulationState& s) {
     if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
     share_plans();
   }
-  if (model_.is_part()) return restore_part(s);
   const size_t n = model_.mesh.num_nodes();
   SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
                       s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
@@ -97,23 +96,6 @@ void Simulation::restore_state(const SimulationState& s) {
   f_int_ = s.f_int;
   f_ext_ = s.f_ext;
   reaction_ = s.reaction;
-  restore_scalars(s);
-}
-
-void Simulation::restore_part(const SimulationState& s) {
-  // The state of the whole model: this part's nodes and reactions from it.
-  const Model::Part& part = model_.part;
-  const size_t n = part.whole_nodes;
-  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
-                      s.f_ext.size() == n && s.reaction.size() == static_cast<size_t>(part.whole_bc_nodes),
-                  "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
-                                                  << " reactions, the whole model " << n << " and "
-                                                  << part.whole_bc_nodes);
-  for (Index i = 0; i < model_.mesh.num_nodes(); ++i) {
-    const Index w = part.node_index[i];
-    x_[i] = s.x[w], v_[i] = s.v[w], a_[i] = s.a[w], f_int_[i] = s.f_int[w], f_ext_[i] = s.f_ext[w];
-  }
-  for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction_[b] = s.reaction[part.bc_index[b]];
   restore_scalars(s);
 }
 

@@ -2,7 +2,8 @@
 # Kill and restart across rank counts (issues 6, 8 and 15): a run on 4 ranks
 # stopped by SIGTERM part way writes a checkpoint and exits non-zero; the
 # restart on 3 ranks must finish with history.csv and bodies.csv byte-equal to
-# an uninterrupted run on 1 rank.
+# an uninterrupted run on 1 rank; and a checkpoint spoiled after it was
+# written is refused on 3 ranks.
 # usage: restart_history.sh SHATTER MPIEXEC SCENE WORKDIR
 set -uo pipefail
 shatter=$1 mpiexec=$2 scene=$3 work=$4
@@ -28,6 +29,15 @@ cut_rows=$(wc -l < "$work/cut/history.csv")
 [ "$cut_rows" -lt "$rows" ] || { echo "FAIL: the run finished before the signal"; exit 1; }
 "${mpi[@]}" -n 3 "$shatter" run "$scene" --restart "$work/cut/checkpoint.h5" --threads 1 --quiet ||
   { echo "FAIL: the restart"; exit 1; }
+# A checkpoint whose positions were changed after it was written: refused
+# on 3 ranks (each reads its own rows, and still checks the whole dataset's hash).
+cp "$work/cut/checkpoint.h5" "$work/spoiled.h5"
+/usr/bin/python3 -c "import h5py; f = h5py.File('$work/spoiled.h5', 'r+'); f['state/positions'][7, 0] += 1e-9; f.close()"
+"${mpi[@]}" -n 3 "$shatter" run "$scene" --restart "$work/spoiled.h5" --out "$work/spoiled" --threads 1 --quiet \
+  2> "$work/spoiled.log"
+status=$?
+[ $status -eq 2 ] && grep -q "dataset positions fails its hash check" "$work/spoiled.log" ||
+  { echo "FAIL: a spoiled checkpoint was not refused (exit $status):"; cat "$work/spoiled.log"; exit 1; }
 for f in history.csv bodies.csv; do
   cmp "$work/whole/$f" "$work/cut/$f" || { echo "FAIL: $f differs"; diff "$work/whole/$f" "$work/cut/$f" | head -4; exit 1; }
 done
