@@ -116,6 +116,7 @@ int cli(int argc, char** argv, FailureChannel& failures) {
   std::vector<std::string> overrides;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool deterministic = false, quiet = false;
+  double max_elements = kDefaultMaxElements;
 
   auto* run = app.add_subcommand("run", "run a scene");
   run->add_option("scene", scene_path, "scene file (YAML)")->required();
@@ -125,9 +126,13 @@ int cli(int argc, char** argv, FailureChannel& failures) {
   run->add_flag("--deterministic", deterministic, "bitwise identical results for any ranks and threads");
   run->add_option("--restart", restart, "continue from a checkpoint");
   run->add_flag("--quiet", quiet, "no progress line and no closing 'done' line; warnings and errors still print");
+  run->add_option("--max-elements", max_elements, "refuse scenes whose shapes Gmsh would mesh into more elements "
+                                                  "(estimated before meshing; default 5e7)")
+      ->check(CLI::PositiveNumber);
   auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
   check->add_option("scene", scene_path, "scene file (YAML)")->required();
   check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+  check->add_option("--max-elements", max_elements, "as for run")->check(CLI::PositiveNumber);
   auto* plot = app.add_subcommand("plot", "plot a run's history.csv into OUTDIR/plots/ (PNG)");
   plot->add_option("outdir", out_dir, "output folder of a run")->required();
 
@@ -159,7 +164,7 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
     // Before the meshing: a folder that cannot take the outputs is bad input.
     if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
-    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF);
+    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF, max_elements);
     sim = std::make_unique<Simulation>(*model, opt);
     if (!restart.empty()) {
       CheckpointRun written;

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <iomanip>
 #include <sstream>
 
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
 #include "mesh/reorder.hpp"
+#include "mesh/shape_estimate.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/mesh_broadcast.hpp"
 #include "runtime/model_part.hpp"
@@ -16,9 +18,30 @@ namespace shatter {
 
 namespace {
 
+/// Before any meshing: every primitive within kMaxCoordinate, and the
+/// estimated elements of all of them at most `max_elements`.
+void check_estimate(const Scene& scene, double max_elements) {
+  double total = 0;
+  for (const BodySpec& body : scene.bodies) {
+    if (!body.mesh_file.empty()) continue;
+    const std::string where = scene.file + ": " + body.key + ".mesh";
+    check_shape_extent(body.shape, where);
+    const double n = estimated_elements(body.shape);
+    total += n;
+    if (total <= max_elements) continue;
+    std::ostringstream os;
+    os << where << ".element_size: about " << std::setprecision(3) << n << " elements estimated for this body ("
+       << kTetsPerCube << " V / h^3, V = " << shape_volume(body.shape) << " m^3, h = " << body.shape.element_size
+       << " m), " << total << " for the scene so far; expected at most " << max_elements
+       << " (--max-elements raises the limit)";
+    throw InputError(os.str());
+  }
+}
+
 /// Every body meshed (or read) and checked, appended in order, the elements
 /// along a space-filling curve.
-Mesh mesh_bodies(const Scene& scene) {
+Mesh mesh_bodies(const Scene& scene, double max_elements) {
+  check_estimate(scene, max_elements);
   Mesh mesh;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
@@ -70,7 +93,7 @@ void complete_model(Model& m);
 
 }  // namespace
 
-Model build_model(const Scene& scene, MPI_Comm comm) {
+Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
   Model m;
   m.scene = scene;
   for (const auto& ms : scene.materials)
@@ -78,16 +101,16 @@ Model build_model(const Scene& scene, MPI_Comm comm) {
   int ranks = 1;
   if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
   if (ranks == 1) {
-    m.mesh = mesh_bodies(scene);
+    m.mesh = mesh_bodies(scene, max_elements);
     complete_model(m);
   } else if (scene.fracture_enabled()) {
     // Fracture still needs the whole model on every rank (docs/parallel.md "Limits").
-    on_root(comm, [&] { m.mesh = mesh_bodies(scene); });
+    on_root(comm, [&] { m.mesh = mesh_bodies(scene, max_elements); });
     broadcast_mesh(m.mesh, 0, comm);
     complete_model(m);
   } else {
     on_root(comm, [&] {
-      m.mesh = mesh_bodies(scene);
+      m.mesh = mesh_bodies(scene, max_elements);
       complete_model(m);
       check_ranks(m, ranks);
     });

@@ -11,6 +11,7 @@
 #include "kernels/neo_hookean.hpp"
 #include "kernels/tet10.hpp"
 #include "mesh/mesh.hpp"
+#include "mesh/shape_estimate.hpp"
 #include "runtime/scene.hpp"
 
 namespace shatter {
@@ -80,7 +81,10 @@ void for_each_array(M& m, F f) {
 /// elements and ghost layer, Model::Part), keeping its own; otherwise every
 /// rank receives the mesh and computes the whole model. Throws InputError
 /// (bad scene or mesh) on every rank.
-Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF);
+/// Before meshing, a primitive beyond kMaxCoordinate, or primitives whose
+/// estimated elements (estimated_elements) add up to more than
+/// `max_elements`, throw InputError naming the body's key.
+Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF, double max_elements = kDefaultMaxElements);
 
 /// Recompute the lumped masses of `nodes` from element_node_mass (after node splitting).
 void recompute_node_masses(Model& model, const std::vector<Index>& nodes);
