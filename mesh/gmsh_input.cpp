@@ -28,9 +28,8 @@ double set_refinement_fields(const ShapeSpec& s) {
   for (const RefineSpec& r : s.refine) {
     const int distance = gmsh::model::mesh::field::add("MathEval");
     const Vec3& c = r.center;
-    gmsh::model::mesh::field::setString(distance, "F",
-                                        "Sqrt((x-(" + exact(c.x()) + "))^2+(y-(" + exact(c.y()) + "))^2+(z-(" +
-                                            exact(c.z()) + "))^2)");
+    gmsh::model::mesh::field::setString(
+        distance, "F", "Sqrt((x-(" + exact(c.x()) + "))^2+(y-(" + exact(c.y()) + "))^2+(z-(" + exact(c.z()) + "))^2)");
     const int threshold = gmsh::model::mesh::field::add("Threshold");
     gmsh::model::mesh::field::setNumber(threshold, "InField", distance);
     gmsh::model::mesh::field::setNumber(threshold, "SizeMin", r.element_size);

@@ -238,7 +238,9 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
         r.fail(key + ".inner_radius", "a value smaller than radius (a hollow sphere)", m["inner_radius"]);
     }
   } else if (s.shape == "tube") {
-    r.only_keys(m, key, {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order", "refine"});
+    r.only_keys(m, key,
+                {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order",
+                 "refine"});
     s.inner_radius = r.positive(r.required(m, key, "inner_radius"), key + ".inner_radius");
     s.outer_radius = r.positive(r.required(m, key, "outer_radius"), key + ".outer_radius");
     if (s.outer_radius <= s.inner_radius)

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "run_checks.hpp"
 #include "runtime/model.hpp"
 #include "runtime/scene_keys.hpp"
 #include "runtime/simulation.hpp"
-#include "run_checks.hpp"
 #include "scene_text.hpp"
 
 using namespace shatter;
