@@ -8,7 +8,7 @@ v, frictionless, e = 1; per mesh the contact duration (first to last step with
 a resolved contact pair) against t_c = 2.87 (m*^2 / (R* E*^2 v))^(1/5) and the
 peak force m dv_cm/dt of one sphere against F_max = 4/3 E* sqrt(R*) d_max^(3/2),
 d_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) (Johnson, Contact Mechanics,
-1985, eqs. 11.23-11.24 and 4.23), m* = m/2 with m the meshed sphere's mass,
+1985, ch. 4 and 11), m* = m/2 with m the meshed sphere's mass,
 R* = R/2, E* = E / (2 (1 - nu^2)). The force is the secant slope of v_cm over
 a window of t_c / 50 (a fixed time, so meshes of different steps compare;
 it lowers a half-sine peak by (pi / 50)^2 / 24 = 2e-4).

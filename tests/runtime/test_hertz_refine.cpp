@@ -2,7 +2,7 @@
 // shape and the restart's physics keys; Hertz impact of two steel spheres
 // with the contact point refined: the contact duration and peak force
 // against Hertz's quasi-static solution (Johnson, Contact Mechanics, 1985,
-// eqs. 11.23-11.24 and 4.23), on a mesh a uniform version of which misses
+// ch. 4 and 11), on a mesh a uniform version of which misses
 // the duration by a quarter.
 #include <gtest/gtest.h>
 
