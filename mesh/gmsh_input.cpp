@@ -2,10 +2,51 @@
 
 #include <gmsh.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "kernels/error.hpp"
 #include "mesh/gmsh_model.hpp"
 
 namespace shatter {
+namespace {
+
+/// A number as Gmsh's expression parser reads it back exactly.
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// The background size field of the refinements of `s`: per refinement a
+/// Threshold (size h up to distance r, linear to the body's size at
+/// r + (H - h) / kRefineGrading) on a MathEval field of the distance to its
+/// centre, and the Min of them. Returns the smallest size asked for.
+double set_refinement_fields(const ShapeSpec& s) {
+  std::vector<double> thresholds;
+  double smallest = s.element_size;
+  for (const RefineSpec& r : s.refine) {
+    const int distance = gmsh::model::mesh::field::add("MathEval");
+    const Vec3& c = r.center;
+    gmsh::model::mesh::field::setString(
+        distance, "F", "Sqrt((x-(" + exact(c.x()) + "))^2+(y-(" + exact(c.y()) + "))^2+(z-(" + exact(c.z()) + "))^2)");
+    const int threshold = gmsh::model::mesh::field::add("Threshold");
+    gmsh::model::mesh::field::setNumber(threshold, "InField", distance);
+    gmsh::model::mesh::field::setNumber(threshold, "SizeMin", r.element_size);
+    gmsh::model::mesh::field::setNumber(threshold, "SizeMax", s.element_size);
+    gmsh::model::mesh::field::setNumber(threshold, "DistMin", r.radius);
+    gmsh::model::mesh::field::setNumber(threshold, "DistMax",
+                                        r.radius + (s.element_size - r.element_size) / kRefineGrading);
+    thresholds.push_back(threshold);
+    smallest = std::min(smallest, r.element_size);
+  }
+  const int min = gmsh::model::mesh::field::add("Min");
+  gmsh::model::mesh::field::setNumbers(min, "FieldsList", thresholds);
+  gmsh::model::mesh::field::setAsBackgroundMesh(min);
+  return smallest;
+}
+
+}  // namespace
 
 Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& where) {
   GmshSession session;
@@ -51,10 +92,15 @@ Mesh mesh_shape(const ShapeSpec& s, int body, int material, const std::string& w
     throw InputError(where + ".shape: expected one of box, cylinder, sphere, tube; got '" + s.shape + "'");
   }
   gmsh::model::occ::synchronize();
-  gmsh::option::setNumber("Mesh.MeshSizeMin", s.element_size);
+  const double smallest = s.refine.empty() ? s.element_size : set_refinement_fields(s);
+  gmsh::option::setNumber("Mesh.MeshSizeMin", smallest);
   gmsh::option::setNumber("Mesh.MeshSizeMax", s.element_size);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
+  // Extending the sizes of the boundary's mesh into the surfaces and volume
+  // carries a refinement along the curves it touches (an OCC sphere's seam
+  // at +x kept 0.45 mm edges 4 mm away where 1 mm was asked): with a size
+  // field, the field alone sets the size.
+  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", s.refine.empty() ? 1 : 0);
   gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay
   gmsh::option::setNumber("Mesh.ElementOrder", s.order);
   // Second-order nodes on a curved boundary can fold the elements beneath

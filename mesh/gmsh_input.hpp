@@ -9,6 +9,15 @@
 
 namespace shatter {
 
+/// A ball of local refinement: element size `element_size` within `radius`
+/// of `center`, growing linearly outward to the body's size (mesh_shape).
+/// Lengths in m.
+struct RefineSpec {
+  Vec3 center = Vec3::Zero();
+  double radius = 0;
+  double element_size = 0;
+};
+
 /// A primitive shape to mesh. Lengths in m. `where` names the scene key for errors.
 struct ShapeSpec {
   std::string shape;               ///< box | cylinder | sphere | tube
@@ -25,9 +34,20 @@ struct ShapeSpec {
   Vec3 notch_center = Vec3::Zero();
   Vec3 notch_size = Vec3::Zero();
   int order = 1;                   ///< 1 = TET4, 2 = TET10
+  std::vector<RefineSpec> refine;  ///< local refinements, each with element_size <= the body's
 };
 
+/// Growth of the element size with distance beyond a refinement ball, in m
+/// of size per m of distance: a refinement of h in a body of size H grades
+/// over (H - h) / kRefineGrading beyond its radius, so neighbouring elements
+/// differ by a factor of about 1 + kRefineGrading.
+inline constexpr double kRefineGrading = 0.3;
+
 /// Mesh a primitive shape; all nodes and elements get `body` and `material`.
+/// With `refine`, the target size at a point is the smallest of the body's
+/// element_size and, for each refinement, h within r of its centre, rising
+/// linearly to the body's size at r + (element_size - h) / kRefineGrading
+/// (Gmsh Threshold fields on the distance to the centre).
 Mesh mesh_shape(const ShapeSpec& spec, int body, int material, const std::string& where);
 
 }  // namespace shatter

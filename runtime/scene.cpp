@@ -187,11 +187,34 @@ void refuse_large_scene(std::uintmax_t bytes, const std::string& path) {
                      std::to_string(kMaxSceneBytes) + " (1 MiB: a scene names shapes, mesh files and numbers)");
 }
 
+// mesh.refine: a list of balls {center, radius, element_size}, each size at
+// most the body's (a refinement, not a coarsening).
+std::vector<RefineSpec> read_refine(const Reader& r, const YAML::Node& n, const std::string& key, double body_size) {
+  if (!n.IsSequence() || n.size() == 0)
+    r.fail(key, "a non-empty list of {center: [x, y, z], radius: r, element_size: h}", n);
+  std::vector<RefineSpec> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    r.only_keys(n[i], k, {"center", "radius", "element_size"});
+    RefineSpec f;
+    f.center = r.vec3(r.required(n[i], k, "center"), k + ".center");
+    f.radius = r.positive(r.required(n[i], k, "radius"), k + ".radius");
+    f.element_size = r.positive(r.required(n[i], k, "element_size"), k + ".element_size");
+    if (f.element_size > body_size) {
+      std::ostringstream os;
+      os << "a positive number at most the body's element_size " << body_size;
+      r.fail(k + ".element_size", os.str(), n[i]["element_size"]);
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
 ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& key) {
   ShapeSpec s;
   s.shape = r.string(r.required(m, key, "shape"), key + ".shape");
   if (s.shape == "box") {
-    r.only_keys(m, key, {"shape", "size", "center", "element_size", "order", "notch"});
+    r.only_keys(m, key, {"shape", "size", "center", "element_size", "order", "notch", "refine"});
     s.size = r.vec3(r.required(m, key, "size"), key + ".size");
     if ((s.size.array() <= 0).any()) r.fail(key + ".size", "three positive lengths", m["size"]);
     if (const YAML::Node n = m["notch"]) {
@@ -204,9 +227,9 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
     }
   } else if (s.shape == "cylinder" || s.shape == "sphere") {
     if (s.shape == "cylinder")
-      r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size", "order"});
+      r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size", "order", "refine"});
     else
-      r.only_keys(m, key, {"shape", "radius", "inner_radius", "center", "element_size", "order"});
+      r.only_keys(m, key, {"shape", "radius", "inner_radius", "center", "element_size", "order", "refine"});
     s.radius = r.positive(r.required(m, key, "radius"), key + ".radius");
     if (s.shape == "cylinder") s.length = r.positive(r.required(m, key, "length"), key + ".length");
     if (s.shape == "sphere" && m["inner_radius"]) {
@@ -215,7 +238,9 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
         r.fail(key + ".inner_radius", "a value smaller than radius (a hollow sphere)", m["inner_radius"]);
     }
   } else if (s.shape == "tube") {
-    r.only_keys(m, key, {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order"});
+    r.only_keys(m, key,
+                {"shape", "inner_radius", "outer_radius", "length", "center", "axis", "element_size", "order",
+                 "refine"});
     s.inner_radius = r.positive(r.required(m, key, "inner_radius"), key + ".inner_radius");
     s.outer_radius = r.positive(r.required(m, key, "outer_radius"), key + ".outer_radius");
     if (s.outer_radius <= s.inner_radius)
@@ -230,6 +255,7 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
     if (s.axis.norm() == 0) r.fail(key + ".axis", "a non-zero direction", m["axis"]);
   }
   s.element_size = r.positive(r.required(m, key, "element_size"), key + ".element_size");
+  if (const YAML::Node n = m["refine"]) s.refine = read_refine(r, n, key + ".refine", s.element_size);
   return s;
 }
 

@@ -41,6 +41,12 @@ void shape_keys(KeyWriter& w, const ShapeSpec& s, const std::string& key) {
   w.number(key + ".element_size", s.element_size);
   w.vec3(key + ".notch.center", s.notch_center);
   w.vec3(key + ".notch.size", s.notch_size);
+  for (std::size_t i = 0; i < s.refine.size(); ++i) {
+    const std::string k = key + ".refine[" + std::to_string(i) + "]";
+    w.vec3(k + ".center", s.refine[i].center);
+    w.number(k + ".radius", s.refine[i].radius);
+    w.number(k + ".element_size", s.refine[i].element_size);
+  }
 }
 
 std::map<std::string, std::string> lines_by_key(const std::string& text, std::vector<std::string>& order) {
