@@ -1,7 +1,7 @@
 // shatter — command line (SCENE.md "Command line"):
 //   shatter run SCENE.yaml [--out DIR] [--threads T] [--set key.path=value ...]
-//             [--deterministic] [--restart CHECKPOINT.h5] [--quiet]
-//   shatter check SCENE.yaml [--set ...]
+//             [--deterministic] [--restart CHECKPOINT.h5] [--quiet] [--max-elements N]
+//   shatter check SCENE.yaml [--set ...] [--max-elements N]
 //   shatter plot OUTDIR        (PNGs of a run's history into OUTDIR/plots/)
 // Exit status: 0 success, 2 bad input, 1 failure during the run.
 #include <mpi.h>
@@ -128,11 +128,11 @@ int cli(int argc, char** argv, FailureChannel& failures) {
   run->add_flag("--quiet", quiet, "no progress line and no closing 'done' line; warnings and errors still print");
   run->add_option("--max-elements", max_elements, "refuse scenes whose shapes Gmsh would mesh into more elements "
                                                   "(estimated before meshing; default 5e7)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1.0, 1e15));
   auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
   check->add_option("scene", scene_path, "scene file (YAML)")->required();
   check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
-  check->add_option("--max-elements", max_elements, "as for run")->check(CLI::PositiveNumber);
+  check->add_option("--max-elements", max_elements, "as for run")->check(CLI::Range(1.0, 1e15));
   auto* plot = app.add_subcommand("plot", "plot a run's history.csv into OUTDIR/plots/ (PNG)");
   plot->add_option("outdir", out_dir, "output folder of a run")->required();
 

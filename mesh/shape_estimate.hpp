@@ -18,7 +18,8 @@ inline constexpr double kTetsPerCube = 5.0;
 /// The shape's volume, m^3 (a notch is not taken off: an upper bound).
 double shape_volume(const ShapeSpec& shape);
 
-/// About how many elements Gmsh makes of the shape: kTetsPerCube V / h^3.
+/// About how many elements Gmsh makes of the shape: kTetsPerCube V / h^3,
+/// plus for each refinement its ball and graded shell at their sizes.
 double estimated_elements(const ShapeSpec& shape);
 
 /// Throws InputError naming `where` (e.g. "scene.yaml: bodies[0].mesh") when
