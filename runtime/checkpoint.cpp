@@ -208,6 +208,15 @@ struct Reader {
     digest.add(name, s.data(), s.size());
     return s.c_str();
   }
+  /// Requires the dataspace `space` of dataset `name` to be `expected` x `cols`.
+  void require_shape(const H5Handle& space, const char* name, std::size_t expected, hsize_t cols) const {
+    std::array<hsize_t, 2> dims{0, 0};
+    require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
+                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == cols &&
+                dims[0] == expected,
+            std::string("dataset ") + name + " has the wrong shape (expected " + std::to_string(expected) +
+                " x " + std::to_string(cols) + ")");
+  }
   /// Reads a dataset written by Writer::array: `expected` rows of `cols`
   /// numbers, hash checked.
   template <class T>
@@ -216,12 +225,7 @@ struct Reader {
     require(dset.valid(),
             std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
     H5Handle space(H5Dget_space(dset.get()), H5Sclose);
-    std::array<hsize_t, 2> dims{0, 0};
-    require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
-                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == cols &&
-                dims[0] == expected,
-            std::string("dataset ") + name + " has the wrong shape (expected " +
-                std::to_string(expected) + " x " + std::to_string(cols) + ")");
+    require_shape(space, name, expected, cols);
     std::vector<T> a(expected * cols / FileType<T>::numbers);
     if (expected > 0)
       require(H5Dread(dset.get(), FileType<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data()) >= 0,
@@ -243,12 +247,7 @@ struct Reader {
     require(dset.valid(),
             std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
     H5Handle space(H5Dget_space(dset.get()), H5Sclose);
-    std::array<hsize_t, 2> dims{0, 0};
-    require(space.valid() && H5Sget_simple_extent_ndims(space.get()) == 2 &&
-                H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) == 2 && dims[1] == 3 &&
-                dims[0] == expected,
-            std::string("dataset ") + name + " has the wrong shape (expected " + std::to_string(expected) +
-                " x 3)");
+    require_shape(space, name, expected, 3);
     constexpr hsize_t kBlock = 1 << 16;
     std::vector<Vec3> block, out;
     out.reserve(keep.size());
