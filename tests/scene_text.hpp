@@ -1,5 +1,6 @@
 #pragma once
 // Scenes written from text for tests: the full loader path is exercised.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -31,6 +32,13 @@ inline std::string steel_box_scene(const std::string& name, const std::string& e
          "    material: steel\n"
          "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: " +
          element_size + "}\n" + body + extra;
+}
+
+/// A double as scene text, every bit kept (%.17g).
+inline std::string num(double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", a);
+  return buf;
 }
 
 inline Scene scene_from_text(const std::string& name, const std::string& yaml) {

@@ -43,16 +43,11 @@ using namespace shatter;
 using shatter::test::body_centre;
 using shatter::test::body_velocity;
 using shatter::test::count_penetrations;
+using shatter::test::num;
 using shatter::test::scene_from_text;
 using shatter::test::write_scene;
 
 namespace {
-
-std::string num(double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", a);
-  return buf;
-}
 
 std::string vec(const Vec3& a) {
   char buf[96];

@@ -20,15 +20,10 @@
 
 using namespace shatter;
 using shatter::test::body_velocity;
+using shatter::test::num;
 using shatter::test::scene_from_text;
 
 namespace {
-
-std::string num(double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", a);
-  return buf;
-}
 
 }  // namespace
 
