@@ -205,6 +205,7 @@ int main(int argc, char** argv) {
     FailureChannel failures(MPI_COMM_WORLD);
     status = cli(argc, argv, failures);
   }
+  if (status != 0) ignore_stop_signals();
   release_disk_space();
   MPI_Finalize();
   return status;

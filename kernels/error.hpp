@@ -17,6 +17,14 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A failure during a run whose cause is the scene's physics (a collapsed
+/// stable step, an energy overflow): a smaller time step does not cure it,
+/// and a restart cannot change the physics. Exit 1.
+class PhysicsError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Bad input (scene, mesh, command line): exit 2. The message names the file,
 /// the key path and what was expected.
 class InputError : public std::runtime_error {

@@ -52,4 +52,9 @@ void set_setup_stop_rank(int rank) {
   g_rank = rank;
 }
 
+void ignore_stop_signals() {
+  std::signal(SIGINT, SIG_IGN);
+  std::signal(SIGTERM, SIG_IGN);
+}
+
 }  // namespace shatter

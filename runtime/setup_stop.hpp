@@ -21,4 +21,10 @@ void install_setup_stop_handlers();
 /// Tells the handlers this process's rank: only rank 0 prints.
 void set_setup_stop_rank(int rank);
 
+/// After the process's failure was reported: SIGINT and SIGTERM are ignored
+/// while it finishes (mpirun sends SIGTERM to the ranks still finishing once
+/// one rank has exited non-zero; the set-up handler then printed a second,
+/// wrong message).
+void ignore_stop_signals();
+
 }  // namespace shatter

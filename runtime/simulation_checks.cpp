@@ -29,9 +29,9 @@ void Simulation::check_step_collapse(long step, double time) {
   StepCollapse c;
   c.dt = stable_dt_;
   c.dt0 = stable_dt0_;
-  if (least.e == std::numeric_limits<int>::max()) throw Error(step_collapse_diagnosis(model_, c, step, time));
+  if (least.e == std::numeric_limits<int>::max()) throw PhysicsError(step_collapse_diagnosis(model_, c, step, time));
   // Its owner has its current positions and its part of the mesh.
-  throw Error(from_owner(least.e, [&](Index e) {
+  throw PhysicsError(from_owner(least.e, [&](Index e) {
     c.element = e;
     c.element_dt = least.dt;
     for (int a = 0; a < 4; ++a) c.centre += 0.25 * x_[model_.mesh.element(e)[a]];
@@ -57,7 +57,7 @@ void Simulation::check_ledger() {
   const std::string why = ledger_diagnosis(kEnergyOverflow, model_, x_, v_, a_, ledger_, step_, time_);
   // In the initial state (the constructor's ledger) only the scene can be the cause.
   if (step_ == 0) throw InputError(model_.scene.file + ": " + why);
-  throw Error(why);
+  throw PhysicsError(why);
 }
 
 }  // namespace shatter

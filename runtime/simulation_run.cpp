@@ -70,8 +70,14 @@ long Simulation::run() {
       } catch (const Error& w) {
         throw Error(std::string(e.what()) + "\n" + w.what());
       }
-      throw Error(std::string(e.what()) + "\nthe last good state (step " + std::to_string(good.step) +
-                  ") is in " + checkpoint.string() + ": continue from it with --restart " + checkpoint.string() +
+      const std::string saved =
+          std::string(e.what()) + "\nthe last good state (step " + std::to_string(good.step) + ") is in " +
+          checkpoint.string();
+      // A smaller step cures an inverted element, not a cause in the scene's physics.
+      if (dynamic_cast<const PhysicsError*>(&e))
+        throw Error(saved + ": a restart would continue the same physics (it refuses changed physics keys), so "
+                            "correct the scene (the likely cause above) and run it again");
+      throw Error(saved + ": continue from it with --restart " + checkpoint.string() +
                   " and a smaller --set time.safety=...");
     }
     const bool last = time_ >= scene.end_time - tiny;

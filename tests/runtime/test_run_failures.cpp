@@ -61,6 +61,12 @@ std::string expect_failure_with_checkpoint(const std::string& scene, const fs::p
   EXPECT_NE(r.output.find("the last good state (step " + std::to_string(s.step) + ") is in " + checkpoint.string()),
             std::string::npos)
       << r.output;
+  // The cause is in the scene: no advice to restart with a smaller step.
+  EXPECT_NE(r.output.find(": a restart would continue the same physics (it refuses changed physics keys), so "
+                          "correct the scene (the likely cause above) and run it again"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("time.safety"), std::string::npos) << r.output;
   EXPECT_EQ(last_history_step(dir), s.step);
   EXPECT_EQ(failure_attribute(checkpoint), r.first_line().substr(7));
   const auto again = run_shatter("run " + scene + " --quiet --threads 1 --restart " + checkpoint.string());
