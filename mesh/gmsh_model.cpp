@@ -105,14 +105,16 @@ GmshSession::~GmshSession() {
   }
 }
 
-void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where) {
+void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where,
+                  const std::string& copy_of) {
   try {
     gmsh::open(path);
   } catch (...) {  // Gmsh 4.8 throws a bare value; its log holds the reason
     std::string last;
     gmsh::logger::getLastError(last);
-    throw InputError(where + ": Gmsh cannot read '" + path + "' as " + format + " file" +
-                     (last.empty() ? "" : ": " + last));
+    const std::string what = copy_of.empty() ? "'" + path + "' as " + format + " file"
+                                             : "its .msh copy of '" + copy_of + "' (a file it read but wrote unreadably)";
+    throw InputError(where + ": Gmsh cannot read " + what + (last.empty() ? "" : ": " + last));
   }
 }
 

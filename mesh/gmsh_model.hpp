@@ -28,8 +28,11 @@ class GmshSession {
 
 /// Open a mesh file into the model (Gmsh picks the reader by extension).
 /// A file Gmsh cannot read throws InputError naming `where`, the file, the
-/// format it was read as (`format`, with its article: "a .msh") and Gmsh's last error.
-void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where);
+/// format it was read as (`format`, with its article: "a .msh") and Gmsh's last error;
+/// `copy_of` (when not empty): `path` is Gmsh's own copy of that user's file,
+/// and the message names the user's file.
+void open_in_gmsh(const std::string& path, const std::string& format, const std::string& where,
+                  const std::string& copy_of = "");
 
 /// The volumes (3D entity tags) of the physical volume named `physical`, or
 /// every volume when it is empty. InputError when no physical volume has

@@ -83,7 +83,7 @@ Mesh read_through_child(const std::string& path, const char* format, const std::
                            ("shatter_mesh_" + std::to_string(getpid()) + "_" + std::to_string(serial++) + ".msh")};
   convert_to_msh_in_child(path, format, copy.path.string(), where);
   const int order = tetrahedron_order(scan_msh_elements(copy.path.string(), where, path), path, where);
-  open_in_gmsh(copy.path.string(), "a .msh", where);
+  open_in_gmsh(copy.path.string(), "a .msh", where, path);
   return tetrahedra_of_model(order, path, physical, body, material, where);
 }
 
