@@ -50,10 +50,9 @@ void print_check(const Model& model, const Simulation& sim) {
   MeshScaledJacobian worst;
   if (mesh.order == 2) {
     worst = min_scaled_jacobian(mesh);
-    double value = worst.value, gid = static_cast<double>(worst.element);
-    const int rank = d.rank_of_min(value);
-    d.broadcast({&gid, 1}, rank);
-    worst = {d.min(value), static_cast<GlobalId>(gid)};
+    double least[2] = {worst.value, static_cast<double>(worst.element)};
+    d.broadcast(least, d.rank_of_min(least[0]));
+    worst = {least[0], static_cast<GlobalId>(least[1])};
   }
   const double dt = s.fixed_dt ? *s.fixed_dt : sim.stable_dt();
   // The model's arrays plus the solver's five nodal vectors and work arrays, the largest rank's.

@@ -61,6 +61,8 @@ YAML
 # ~0.5 M; at 2-4 M asked, Gmsh gives about half: 4 000 000 asked -> 2 111 501 tets).
 size_for() { python3 -c "print(f'{0.1 * (9798 / $1) ** (1 / 2.93):.5f}')"; }
 key() { grep -o "\"$2\": [-0-9.e+]*" "$1/summary.json" | awk '{print $2}'; }
+# A summary.json key of bytes, in MB.
+mb() { key "$1" "$2" | awk '{printf "%.0f", $1 / 1e6}'; }
 # peak_memory_bytes_per_rank of a run as MB: rank 0's, the largest other's, the sum.
 peaks() {
   local p
@@ -110,7 +112,7 @@ elif [ "$mode" = capacity ]; then
   wall=$(( $(date +%s) - start ))
   col=$(head -1 "$dir/history.csv" | tr ',' '\n' | grep -n '^contacts$' | cut -d: -f1)
   contacts=$(tail -n +2 "$dir/history.csv" | cut -d, -f"$col" | sort -n | tail -1)
-  echo "$ranks,$(key "$dir" elements),$(key "$dir" steps),$contacts,$wall,$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
+  echo "$ranks,$(key "$dir" elements),$(key "$dir" steps),$contacts,$wall,$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max)" | tee -a "$out"
 elif [ "$mode" = memory ]; then
   elements=${3:-2000000}
   max_ranks=${4:-8}
@@ -124,7 +126,7 @@ elif [ "$mode" = memory ]; then
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet \
       --set "contact=null" --set "bodies=[{name: box, material: seed, mesh: {shape: box, size: [1.0, 1.0, 1.0], element_size: $h}, initial_velocity: [20.0, 0.0, 0.0]}]" \
       --set time.end=1.0e-9 --set time.dt=5.0e-11
-    echo "$r,$(key "$dir" elements),$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
+    echo "$r,$(key "$dir" elements),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max)" | tee -a "$out"
     r=$((r * 2))
   done
 else
@@ -138,7 +140,7 @@ else
     dir="$work/weak$r"
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
       --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
-    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(key "$dir" model_bytes_per_rank_max | awk '{printf "%.0f", $1 / 1e6}')" | tee -a "$out"
+    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max)" | tee -a "$out"
     r=$((r * 2))
   done
 fi

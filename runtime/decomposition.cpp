@@ -74,6 +74,12 @@ void check_ranks(const Model& model, int ranks) {
                      std::to_string(ng) + ")");
 }
 
+NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank) {
+  std::vector<int> elem_part(mesh.num_elements());
+  for (Index e = 0; e < mesh.num_elements(); ++e) elem_part[e] = granule_rank[e / ElementForces::kGranule];
+  return touching_ranks(mesh, elem_part);
+}
+
 void Decomposition::rebuild_nodes() {
   const Mesh& mesh = model_.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
@@ -82,10 +88,9 @@ void Decomposition::rebuild_nodes() {
   // Home granule of each node: the granule of the first element of its star;
   // the home nodes of each owned granule, ascending.
   home_granule_.resize(nn);
-  // (A ghost-only node of a part may not hold its whole star here, but no
-  // element of it is owned here, so neither is the granule computed.)
-  // A part's contact-surface nodes outside its elements have no star here,
-  // and no home granule (-1: they are never owned here).
+  // On a part, a ghost-only node's star may not be whole here, but none of
+  // it is owned here, so neither is the granule computed; a contact-surface
+  // node outside the part's elements has no star and no home granule (-1).
   for (Index n = 0; n < nn; ++n)
     home_granule_[n] = mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
                            ? -1
@@ -93,16 +98,18 @@ void Decomposition::rebuild_nodes() {
   {
     std::vector<Index> slot(num_granules(), -1);
     for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
+    // The index k of node n's home granule among the owned ones, -1 if not owned.
+    auto home_slot = [&](Index n) { return home_granule_[n] < 0 ? -1 : slot[home_granule_[n]]; };
     home_offsets_.assign(owned_granules_.size() + 1, 0);
     for (Index n = 0; n < nn; ++n)
-      if (home_granule_[n] >= 0 && slot[home_granule_[n]] >= 0) ++home_offsets_[slot[home_granule_[n]] + 1];
+      if (home_slot(n) >= 0) ++home_offsets_[home_slot(n) + 1];
     for (size_t k = 0; k < owned_granules_.size(); ++k) home_offsets_[k + 1] += home_offsets_[k];
     home_nodes_.resize(home_offsets_.back());
     owned_nodes_.clear();
     std::vector<Index> fill(home_offsets_.begin(), home_offsets_.end() - 1);
     for (Index n = 0; n < nn; ++n)
-      if (home_granule_[n] >= 0 && slot[home_granule_[n]] >= 0) {
-        home_nodes_[fill[slot[home_granule_[n]]]++] = n;
+      if (home_slot(n) >= 0) {
+        home_nodes_[fill[home_slot(n)]++] = n;
         owned_nodes_.push_back(n);
       }
   }
@@ -121,9 +128,7 @@ void Decomposition::rebuild_nodes() {
     node_rank_offsets_ = model_.part.node_rank_offsets;
     node_ranks_ = model_.part.node_ranks;
   } else {
-    std::vector<int> elem_part(ne);
-    for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[e / ElementForces::kGranule];
-    NodeRanks touch = touching_ranks(mesh, elem_part);
+    NodeRanks touch = granule_touching_ranks(mesh, granule_rank_);
     node_rank_offsets_ = std::move(touch.offsets);
     node_ranks_ = std::move(touch.ranks);
   }
@@ -227,15 +232,11 @@ std::vector<std::vector<Vec3>> Decomposition::gather_to_root(std::span<const std
   }
   // Each node from its owner, as rows of the whole model's node order.
   std::vector<Index> rows;
-  for (Index n : touched_nodes_)
-    if (node_owner(n) == rank_) rows.push_back(model_.whole_node(n));
-  std::vector<double> values(rows.size() * 3 * m);
-  for (size_t r = 0, k = 0; r < touched_nodes_.size(); ++r) {
-    const Index n = touched_nodes_[r];
+  std::vector<double> values;
+  for (Index n : touched_nodes_) {
     if (node_owner(n) != rank_) continue;
-    for (size_t a = 0; a < m; ++a)
-      for (int c = 0; c < 3; ++c) values[(k * m + a) * 3 + c] = arrays[a][n][c];
-    ++k;
+    rows.push_back(model_.whole_node(n));
+    for (size_t a = 0; a < m; ++a) values.insert(values.end(), arrays[a][n].data(), arrays[a][n].data() + 3);
   }
   // The local ids ascend with the whole ids, so the rows do too.
   const std::vector<double> all =

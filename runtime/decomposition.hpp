@@ -34,6 +34,7 @@
 
 #include "kernels/exact_sum.hpp"
 #include "kernels/types.hpp"
+#include "mesh/partition.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/model.hpp"
 #include "runtime/parallel.hpp"
@@ -175,6 +176,10 @@ class Decomposition {
 /// Throws InputError when `model` has fewer granules than `ranks`, saying how
 /// many ranks it can take.
 void check_ranks(const Model& model, int ranks);
+
+/// The ranks touching each node of the whole mesh `mesh` when granule g
+/// (ElementForces::kGranule elements) belongs to granule_rank[g].
+NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank);
 
 template <class Body>
 void Decomposition::for_touched(Index num_nodes, Body body) const {

@@ -8,6 +8,7 @@
 #include "contact/surface.hpp"
 #include "mesh/partition.hpp"
 #include "runtime/checkpoint.hpp"
+#include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
 
 namespace shatter {
@@ -30,9 +31,7 @@ Partition partition(const Model& whole, int ranks) {
   const Mesh& mesh = whole.mesh;
   p.granule_rank = partition_granules(mesh, ElementForces::kGranule, ranks);
   p.block_color = block_colors(mesh);
-  std::vector<int> elem_part(mesh.num_elements());
-  for (Index e = 0; e < mesh.num_elements(); ++e) elem_part[e] = p.granule_rank[e / ElementForces::kGranule];
-  p.touch = touching_ranks(mesh, elem_part);
+  p.touch = granule_touching_ranks(mesh, p.granule_rank);
   p.bc_index.assign(mesh.num_nodes(), -1);
   for (Index n = 0; n < mesh.num_nodes(); ++n)
     if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;

@@ -130,9 +130,7 @@ void Simulation::compute_forces(long step, double time, const std::function<void
       return os.str();
     });
     std::ostringstream os;
-    os << "step " << step << ", t = " << time << " s: "
-       << (where.empty() ? std::string(std::isnan(J) ? "NaN coordinates" : "an inverted element") : where)
-       << "; try a smaller time.safety or a finer mesh";
+    os << "step " << step << ", t = " << time << " s: " << where << "; try a smaller time.safety or a finer mesh";
     throw Error(os.str());
   }
   check_step_collapse(step, time);

@@ -22,8 +22,8 @@ void Simulation::check_step_collapse(long step, double time) {
   } least{HUGE_VAL, std::numeric_limits<int>::max()};
   for (Index e : dec_->owned_element_ids()) {
     const double dt = element_stable_step(model_, x_, e).dt;
-    const int whole = static_cast<int>(model_.whole_element(e));
-    if (dt < least.dt || (dt == least.dt && whole < least.e)) least = {dt, whole};
+    // Ascending local ids ascend in the whole model too: the first of a tie is the smallest.
+    if (dt < least.dt) least = {dt, static_cast<int>(model_.whole_element(e))};
   }
   if (dec_->distributed()) MPI_Allreduce(MPI_IN_PLACE, &least, 1, MPI_DOUBLE_INT, MPI_MINLOC, dec_->comm());
   StepCollapse c;

@@ -18,20 +18,28 @@ inline std::string write_scene(const std::string& name, const std::string& yaml)
   return path.string();
 }
 
-/// The scene the command-line tests share: one steel box of 1 cm named b,
-/// meshed at `element_size`; `body` lines (indented by four spaces) are
-/// added to the body, `extra` lines at the top level.
-inline std::string steel_box_scene(const std::string& name, const std::string& element_size = "0.005",
-                                   const std::string& body = "", const std::string& extra = "") {
-  return "name: " + name +
-         "\ntime: {end: 1.0e-6}\n"
+/// A scene of one steel body named b, run to `end` s, its mesh given by
+/// `mesh` (the inside of mesh: {...}); `body` lines (indented by four
+/// spaces) are added to the body, `extra` lines at the top level.
+inline std::string steel_body_scene(const std::string& name, const std::string& mesh, const std::string& body = "",
+                                    const std::string& extra = "", const std::string& end = "1.0") {
+  return "name: " + name + "\ntime: {end: " + end +
+         "}\n"
          "materials:\n"
          "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
          "bodies:\n"
          "  - name: b\n"
          "    material: steel\n"
-         "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: " +
-         element_size + "}\n" + body + extra;
+         "    mesh: {" +
+         mesh + "}\n" + body + extra;
+}
+
+/// The scene the command-line tests share: one steel box of 1 cm named b,
+/// meshed at `element_size`, run to 1e-6 s (body and extra as above).
+inline std::string steel_box_scene(const std::string& name, const std::string& element_size = "0.005",
+                                   const std::string& body = "", const std::string& extra = "") {
+  return steel_body_scene(name, "shape: box, size: [0.01, 0.01, 0.01], element_size: " + element_size, body, extra,
+                          "1.0e-6");
 }
 
 /// A double as scene text, every bit kept (%.17g).

@@ -26,14 +26,8 @@ const Model& box() {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     return build_model(test::scene_from_text(
         "decomposition_box_rank" + std::to_string(rank),
-        "name: decomposition_box\n"
-        "time: {end: 1.0}\n"
-        "materials:\n"
-        "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-        "bodies:\n"
-        "  - name: b\n"
-        "    material: steel\n"
-        "    mesh: {shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1}\n"));
+        test::steel_body_scene("decomposition_box",
+                               "shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1")));
   }();
   return m;
 }
@@ -170,16 +164,9 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   const Scene scene = test::scene_from_text(
       "build_model_world_rank" + std::to_string(rank),
-      "name: world\n"
-      "time: {end: 1.0}\n"
-      "materials:\n"
-      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-      "bodies:\n"
-      "  - name: b\n"
-      "    material: steel\n"
-      "    mesh: {shape: sphere, radius: 0.01, element_size: 0.0015, order: 2}\n"
-      "    initial_velocity: [1, 0, 0]\n"
-      "    angular_velocity: [0, 0, 300]\n");
+      test::steel_body_scene("world", "shape: sphere, radius: 0.01, element_size: 0.0015, order: 2",
+                             "    initial_velocity: [1, 0, 0]\n"
+                             "    angular_velocity: [0, 0, 300]\n"));
   const Model part = build_model(scene, MPI_COMM_WORLD);
   const Model whole = build_model(scene);
   EXPECT_EQ(whole_fingerprint(part), model_fingerprint(whole));

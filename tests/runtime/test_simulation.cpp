@@ -18,16 +18,7 @@ namespace {
 
 std::string body_scene(const std::string& name, const std::string& shape, int order, const std::string& extra_body,
                        const std::string& extra = "") {
-  return "name: " + name +
-         "\n"
-         "time: {end: 1.0}\n"
-         "materials:\n"
-         "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-         "bodies:\n"
-         "  - name: b\n"
-         "    material: steel\n"
-         "    mesh: {" +
-         shape + ", order: " + std::to_string(order) + "}\n" + extra_body + extra;
+  return shatter::test::steel_body_scene(name, shape + ", order: " + std::to_string(order), extra_body, extra);
 }
 
 }  // namespace
