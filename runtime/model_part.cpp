@@ -39,30 +39,37 @@ Partition partition(const Model& whole, int ranks) {
   return p;
 }
 
-/// Rank r's part of `whole` (without scene and materials).
-Model cut(const Model& whole, const Partition& p, int r) {
+/// The elements each rank holds (its owned ones and their ghost layer:
+/// every element with a node it touches), ascending; one pass over the mesh.
+std::vector<std::vector<Index>> held_elements(const Mesh& wm, const NodeRanks& touch, int ranks) {
+  std::vector<std::vector<Index>> held(ranks);
+  std::vector<int> rs;
+  for (Index e = 0; e < wm.num_elements(); ++e) {
+    rs.clear();
+    for (int a = 0; a < wm.nodes_per_element(); ++a)
+      for (int q : touch.of(wm.element(e)[a])) rs.push_back(q);
+    std::sort(rs.begin(), rs.end());
+    rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+    for (int q : rs) held[q].push_back(e);
+  }
+  return held;
+}
+
+/// Rank r's part of `whole` (without scene and materials), from the
+/// elements it holds. `local`: scratch of one entry per whole node, -1 on
+/// entry and on return.
+Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, std::vector<Index>& local) {
   const Mesh& wm = whole.mesh;
   const int k = wm.nodes_per_element();
   Model m;
   Model::Part& part = m.part;
-  auto touches = [&](Index n) {
-    const std::span<const int> rs = p.touch.of(n);
-    return std::binary_search(rs.begin(), rs.end(), r);
-  };
-  std::vector<Index> local(wm.num_nodes(), -1);
-  for (Index e = 0; e < wm.num_elements(); ++e) {
-    bool held = false;
-    for (int a = 0; a < k && !held; ++a) held = touches(wm.element(e)[a]);
-    if (!held) continue;
-    part.element_index.push_back(e);
-    for (int a = 0; a < k; ++a) local[wm.element(e)[a]] = 0;
-  }
-  for (Index n : p.surface.vertices) local[n] = 0;
-  for (Index n = 0; n < wm.num_nodes(); ++n)
-    if (local[n] == 0) {
-      local[n] = static_cast<Index>(part.node_index.size());
-      part.node_index.push_back(n);
-    }
+  part.element_index = std::move(elements);
+  for (Index e : part.element_index)
+    for (int a = 0; a < k; ++a) part.node_index.push_back(wm.element(e)[a]);
+  part.node_index.insert(part.node_index.end(), p.surface.vertices.begin(), p.surface.vertices.end());
+  std::sort(part.node_index.begin(), part.node_index.end());
+  part.node_index.erase(std::unique(part.node_index.begin(), part.node_index.end()), part.node_index.end());
+  for (size_t i = 0; i < part.node_index.size(); ++i) local[part.node_index[i]] = static_cast<Index>(i);
 
   Mesh& mesh = m.mesh;
   mesh.order = wm.order;
@@ -104,6 +111,7 @@ Model cut(const Model& whole, const Partition& p, int r) {
   }
   m.body_mass = whole.body_mass;
   m.body_volume = whole.body_volume;
+  for (Index n : part.node_index) local[n] = -1;
   part.granule_rank = p.granule_rank;
   part.whole_elements = wm.num_elements();
   part.whole_nodes = wm.num_nodes();
@@ -162,8 +170,10 @@ void distribute_parts(Model& model, MPI_Comm comm) {
   MPI_Comm_size(comm, &ranks);
   if (rank != 0) return receive_part(model, comm);
   const Partition p = partition(model, ranks);
-  for (int r = 1; r < ranks; ++r) send_part(cut(model, p, r), r, comm);
-  Model mine = cut(model, p, 0);
+  std::vector<std::vector<Index>> held = held_elements(model.mesh, p.touch, ranks);
+  std::vector<Index> local(model.mesh.num_nodes(), -1);
+  for (int r = 1; r < ranks; ++r) send_part(cut(model, p, std::move(held[r]), local), r, comm);
+  Model mine = cut(model, p, std::move(held[0]), local);
   // (cut() grows its arrays one push at a time; the received ones are exact.)
   for_each_array(mine, [](auto& v) { v.shrink_to_fit(); });
   mine.scene = std::move(model.scene);
