@@ -66,6 +66,15 @@ FacetKinematics facet_kinematics(const CohesiveElements& coh, Index c, int k,
   return s;
 }
 
+/// The elements of `share`: count(), the i-th's index, and whether it counts.
+struct ShareView {
+  CohesiveShare share;
+  Index all;
+  Index count() const { return share.computed.empty() && share.counted.empty() ? all : static_cast<Index>(share.computed.size()); }
+  Index operator[](Index i) const { return share.computed.empty() ? i : share.computed[i]; }
+  bool counted(Index i) const { return share.counted.empty() || share.counted[i]; }
+};
+
 }  // namespace
 
 Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& coh,
@@ -115,28 +124,31 @@ Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements&
 }
 
 CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& coh,
-                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int) {
+                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int,
+                               CohesiveShare share) {
   const int k = mesh.order == 1 ? 3 : 6;
-  const Index nc = coh.size();
+  const ShareView which{share, coh.size()};
+  const Index nc = which.count();
   // Blocks of elements: local forces computed in parallel into a buffer that
   // stays in cache, then scattered serially in element order, so the sums
   // do not depend on the threads.
   constexpr Index kBlock = 4096;
   std::vector<Vec3> local_force(static_cast<size_t>(std::min(nc, kBlock)) * 2 * k);
-  std::vector<CohesiveEnergy> local_energy(std::min(nc, kBlock));
+  std::vector<std::array<double, 2>> local_energy(std::min(nc, kBlock));  // stored, dissipated
   CohesiveEnergy total;
   for (Index first = 0; first < nc; first += kBlock) {
     const Index last = std::min(nc, first + kBlock);
     tbb::parallel_for(
         tbb::blocked_range<Index>(first, last, 256), [&](const tbb::blocked_range<Index>& r) {
-          for (Index c = r.begin(); c != r.end(); ++c) {
+          for (Index i = r.begin(); i != r.end(); ++i) {
+            const Index c = which[i];
             const std::optional<CohesiveLaw> law_or = facet_law(mesh, topo, laws, coh.facet[c]);
             SHATTER_ASSERT(law_or);  // insertion happens only where the criterion has a law
             const CohesiveLaw& law = *law_or;
-            Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
+            Vec3* f = local_force.data() + static_cast<size_t>(i - first) * 2 * k;
             std::fill(f, f + 2 * k, Vec3::Zero());
-            CohesiveEnergy& energy = local_energy[c - first];
-            energy = CohesiveEnergy{};
+            auto& [stored, dissipated] = local_energy[i - first];
+            stored = dissipated = 0;
             if (topo.facet_state[coh.facet[c]] == FacetState::free) {
               // Debonded: no traction is left, and no compression penalty either:
               // its faces may have moved apart by many element sizes, where the
@@ -144,7 +156,7 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
               // "interpenetration" once reached 3700 sigma_c and inverted an
               // element of the fine expanding ring, docs/validation.md). Crack
               // faces meet through contact.
-              energy.dissipated = law.fracture_energy() * coh.area[c];
+              dissipated = law.fracture_energy() * coh.area[c];
               continue;
             }
             const FacetKinematics fs = facet_kinematics(coh, c, k, x);
@@ -161,8 +173,8 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
                 f[k + j] += (w * N[j]) * t.traction;
                 f[j] -= (w * N[j]) * t.traction;
               }
-              energy.stored += w * t.stored;
-              energy.dissipated += w * t.dissipated;
+              stored += w * t.stored;
+              dissipated += w * t.dissipated;
               dE_dn += w * t.dphi_dn;
             }
             // The normal follows the mid-surface corners m_j = (x0_j + x1_j) / 2:
@@ -180,15 +192,16 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
             }
           }
         });
-    for (Index c = first; c < last; ++c) {
-      const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
-      const Vec3* f = local_force.data() + static_cast<size_t>(c - first) * 2 * k;
+    for (Index i = first; i < last; ++i) {
+      const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(which[i]) * 2 * kSlots;
+      const Vec3* f = local_force.data() + static_cast<size_t>(i - first) * 2 * k;
       for (int j = 0; j < k; ++j) {
         f_int[nodes[j]] += f[j];
         f_int[nodes[kSlots + j]] += f[k + j];
       }
-      total.stored += local_energy[c - first].stored;
-      total.dissipated += local_energy[c - first].dissipated;
+      if (!which.counted(i)) continue;
+      total.stored += local_energy[i - first][0];
+      total.dissipated += local_energy[i - first][1];
     }
   }
   return total;
@@ -196,7 +209,7 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
 
 double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
                                  const CohesiveElements& coh, FractureLaws laws,
-                                 std::span<const double> mass) {
+                                 std::span<const double> mass, CohesiveShare share) {
   const int k = mesh.order == 1 ? 3 : 6;
   // Per facet node j: sum_q (1/3) |N_j(x_q)| sum_l |N_l(x_q)|, times the area.
   std::array<double, 6> row{};
@@ -207,7 +220,9 @@ double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
     for (int j = 0; j < k; ++j) row[j] += std::abs(N[j]) * sum_abs / kCohesivePoints;
   }
   std::vector<double> stiffness(mass.size(), 0.0);  // Gershgorin row sums, N/m
-  for (Index c = 0; c < coh.size(); ++c) {
+  const ShareView which{share, coh.size()};
+  for (Index i = 0; i < which.count(); ++i) {
+    const Index c = which[i];
     if (topo.facet_state[coh.facet[c]] != FacetState::cohesive) continue;
     const double kc = 2.0 * cohesive_stiffness_bound(*facet_law(mesh, topo, laws, coh.facet[c]));
     const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(c) * 2 * kSlots;
@@ -247,9 +262,12 @@ bool debonded(const CohesiveElements& coh, Index c, const CohesiveLaw& law) {
 }  // namespace
 
 CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveElements& coh,
-                     FractureLaws laws, std::span<const Index> elem_fragment) {
+                     FractureLaws laws, std::span<const Index> elem_fragment, CohesiveShare share) {
   CrackArea a;
-  for (Index c = 0; c < coh.size(); ++c) {
+  const ShareView which{share, coh.size()};
+  for (Index i = 0; i < which.count(); ++i) {
+    if (!which.counted(i)) continue;
+    const Index c = which[i];
     const Index f = coh.facet[c];
     const CohesiveLaw law = *facet_law(mesh, topo, laws, f);
     if (!debonded(coh, c, law)) continue;
@@ -261,24 +279,30 @@ CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveEleme
   return a;
 }
 
-Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,
-                       FractureLaws laws, std::span<const Vec3> x) {
+std::vector<Index> debonded_facets(const Mesh& mesh, const Topology& topo, const CohesiveElements& coh,
+                                   FractureLaws laws, std::span<const Vec3> x, CohesiveShare share) {
   const int k = mesh.order == 1 ? 3 : 6;
-  Index freed = 0;
-  for (Index c = 0; c < coh.size(); ++c) {
-    const Index f = coh.facet[c];
-    if (topo.facet_state[f] != FacetState::cohesive ||
+  std::vector<Index> out;
+  const ShareView which{share, coh.size()};
+  for (Index i = 0; i < which.count(); ++i) {
+    const Index c = which[i], f = coh.facet[c];
+    if (!which.counted(i) || topo.facet_state[f] != FacetState::cohesive ||
         !debonded(coh, c, *facet_law(mesh, topo, laws, f)))
       continue;
     // Not while the compression penalty holds energy: it would vanish from the ledger.
     const FacetKinematics fs = facet_kinematics(coh, c, k, x);
     if (std::all_of(fs.opening.begin(), fs.opening.end(),
-                    [&](const Vec3& o) { return o.dot(fs.area_vector) >= 0; })) {
-      topo.facet_state[f] = FacetState::free;
-      ++freed;
-    }
+                    [&](const Vec3& o) { return o.dot(fs.area_vector) >= 0; }))
+      out.push_back(f);
   }
-  return freed;
+  return out;
+}
+
+Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,
+                       FractureLaws laws, std::span<const Vec3> x) {
+  const std::vector<Index> facets = debonded_facets(mesh, topo, coh, laws, x);
+  for (Index f : facets) topo.facet_state[f] = FacetState::free;
+  return static_cast<Index>(facets.size());
 }
 
 }  // namespace shatter

@@ -2,10 +2,12 @@
 // Cohesive elements: storage, extrinsic insertion with node splitting, and
 // nodal forces (DESIGN.md step 5).
 #include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
 #include "fracture/facet_criterion.hpp"
+#include "kernels/exact_sum.hpp"
 
 namespace shatter {
 
@@ -70,15 +72,27 @@ struct Insertion {
 Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& cohesive,
                                    std::span<const Index> facets);
 
-/// Energies of the cohesive elements, J.
+/// A rank's share of the cohesive elements (MPI, docs/parallel.md "Cohesive
+/// elements on ranks"): `computed`, ascending, the elements it computes (those
+/// with a node it integrates); `counted[i]` whether computed[i] is its own
+/// (its energies and decisions are this rank's). Empty spans: every element,
+/// all counted (one rank).
+struct CohesiveShare {
+  std::span<const Index> computed;
+  std::span<const std::uint8_t> counted;
+};
+
+/// Energies of the cohesive elements, J, summed exactly over the counted
+/// ones (so that partial sums over ranks add up to the same bits).
 struct CohesiveEnergy {
-  double stored = 0;      ///< recoverable (secant and compression penalty)
-  double dissipated = 0;  ///< dissipated up to the current delta_max
+  ExactSum stored;      ///< recoverable (secant and compression penalty)
+  ExactSum dissipated;  ///< dissipated up to the current delta_max
 };
 
 /// Cohesive nodal forces at current positions `x` (m): adds the internal force
 /// dE/dx (same sign as the volume elements' internal forces, N) of every
-/// cohesive element to `f_int`, updates delta_max, and returns the energies.
+/// computed cohesive element (`share`) to `f_int`, updates its delta_max, and
+/// returns the energies of the counted ones.
 /// Traction per unit reference area, integrated on the reference facet with
 /// the 3-point rule; the opening is interpolated with the facet's shape
 /// functions (linear, or quadratic on TET10 facets), the normal is that of the
@@ -89,9 +103,11 @@ struct CohesiveEnergy {
 /// exerts no force, not even the compression penalty, and counts Gc x area
 /// as dissipated.
 /// Element-local forces are computed with oneTBB and scattered in element
-/// order: bitwise identical for any number of threads.
+/// order: bitwise identical for any number of threads, and a node gets the
+/// same bits from any share that computes every element around it.
 CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveElements& cohesive,
-                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int);
+                               FractureLaws laws, std::span<const Vec3> x, std::span<Vec3> f_int,
+                               CohesiveShare share = {});
 
 /// Upper bound of the largest eigenvalue of M^-1 K_c, 1/s^2, where K_c is the
 /// stiffness of the cohesive forces (facets in state `cohesive`) and M the
@@ -103,10 +119,13 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
 /// Since the eigenvalues of M^-1 (K_e + K_c) are at most the sum of the two
 /// bounds, a step 2 / sqrt(omega_e^2 + this) is stable for the volume
 /// elements (omega_e = 2 / stable dt of the elements) and the cohesive
-/// elements together. 0 when there is no cohesive element.
+/// elements together. 0 when there is no cohesive element. Over the computed
+/// elements of `share`: the rows of the nodes they hold whole (every node an
+/// integrating rank computes all elements of) are exact, the others smaller,
+/// so the largest over the ranks is the bound of the whole model.
 double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
                                  const CohesiveElements& cohesive, FractureLaws laws,
-                                 std::span<const double> mass);
+                                 std::span<const double> mass, CohesiveShare share = {});
 
 /// Damage of every element, in [0, 1], for output: the largest over its
 /// facets of min(1, delta_max / delta_c) (largest over the facet's points)
@@ -115,19 +134,21 @@ double cohesive_eigenvalue_bound(const Mesh& mesh, const Topology& topo,
 std::vector<double> element_damage(const Mesh& mesh, const Topology& topo,
                                    const CohesiveElements& cohesive, FractureLaws laws);
 
-/// Crack surfaces of the cohesive elements (reference facet areas, m^2).
+/// Crack surfaces of the cohesive elements (reference facet areas, m^2),
+/// summed exactly (partial sums over ranks add up to the same bits).
 struct CrackArea {
-  double debonded = 0;           ///< facets opened past delta_c at every point (no traction left)
-  double between_fragments = 0;  ///< the part of `debonded` between elements of different fragments
-  double debonded_dissipated = 0;  ///< Gc x area over the debonded facets, J (the rest of the
-                                   ///< dissipated energy is in facets still cohesive)
+  ExactSum debonded;           ///< facets opened past delta_c at every point (no traction left)
+  ExactSum between_fragments;  ///< the part of `debonded` between elements of different fragments
+  ExactSum debonded_dissipated;  ///< Gc x area over the debonded facets, J (the rest of the
+                                 ///< dissipated energy is in facets still cohesive)
 };
 
-/// The crack surface of `cohesive`: debonded facets (every point past
-/// delta_c), and those of them whose two elements are in different fragments
-/// (`elem_fragment`, Fragments::elem_fragment): the through-cracks.
+/// The crack surface of the counted elements of `share`: debonded facets
+/// (every point past delta_c), and those of them whose two elements are in
+/// different fragments (`elem_fragment`, Fragments::elem_fragment): the
+/// through-cracks.
 CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveElements& cohesive,
-                     FractureLaws laws, std::span<const Index> elem_fragment);
+                     FractureLaws laws, std::span<const Index> elem_fragment, CohesiveShare share = {});
 
 /// Mark free the cohesive facets whose every quadrature point has opened past
 /// delta_c (no traction left; the two sides now belong to separate fragments
@@ -136,5 +157,10 @@ CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveEleme
 /// (cohesive_forces). Returns the number of facets freed.
 Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive,
                        FractureLaws laws, std::span<const Vec3> x);
+
+/// The facets release_debonded would free among the counted elements of
+/// `share`, ascending in cohesive element order, without freeing them.
+std::vector<Index> debonded_facets(const Mesh& mesh, const Topology& topo, const CohesiveElements& cohesive,
+                                   FractureLaws laws, std::span<const Vec3> x, CohesiveShare share = {});
 
 }  // namespace shatter

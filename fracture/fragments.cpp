@@ -9,8 +9,6 @@
 
 namespace shatter {
 
-namespace {
-
 Index find_root(std::vector<Index>& parent, Index a) {
   while (parent[a] != a) {
     parent[a] = parent[parent[a]];
@@ -18,6 +16,8 @@ Index find_root(std::vector<Index>& parent, Index a) {
   }
   return a;
 }
+
+namespace {
 
 double current_volume(const Mesh& mesh, std::span<const Vec3> x, Index e) {
   const Index* c = mesh.element(e);

@@ -43,6 +43,10 @@ Fragments find_fragments(const Mesh& mesh, const Topology& topo, std::span<const
 /// The fragments' element ids and count only: topology, no positions.
 Fragments label_fragments(const Mesh& mesh, const Topology& topo);
 
+/// Union-find: the root of a's set in `parent` (each entry its parent, a
+/// root its own), halving the path on the way.
+Index find_root(std::vector<Index>& parent, Index a);
+
 /// The exact partial sums of the statistics of `frags` over `nodes` and
 /// `elements` (each node counts in the fragment of the first element of its
 /// star, each element in its own).

@@ -80,7 +80,7 @@ NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_
   return touching_ranks(mesh, elem_part);
 }
 
-void Decomposition::rebuild_nodes() {
+void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width) {
   const Mesh& mesh = model_.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
   const int k = mesh.nodes_per_element();
@@ -150,6 +150,26 @@ void Decomposition::rebuild_nodes() {
     local_elements_.push_back(e);
     for (int a = 0; a < k; ++a) held[mesh.element(e)[a]] = 1;
   }
+  // The groups around each node (CSR), and the nodes of the groups with a touched node.
+  const Index ng = static_cast<Index>(groups.size() / group_width);
+  auto group = [&](Index g) { return groups.subspan(static_cast<size_t>(g) * group_width, group_width); };
+  std::vector<Index> group_offsets(nn + 1, 0), node_groups;
+  for (Index g = 0; g < ng; ++g) {
+    bool mine = false;
+    for (Index n : group(g))
+      if (n >= 0) ++group_offsets[n + 1], mine = mine || touches(n, rank_);
+    if (mine)
+      for (Index n : group(g))
+        if (n >= 0) held[n] = 1;
+  }
+  for (Index n = 0; n < nn; ++n) group_offsets[n + 1] += group_offsets[n];
+  node_groups.resize(group_offsets[nn]);
+  {
+    std::vector<Index> fill(group_offsets.begin(), group_offsets.end() - 1);
+    for (Index g = 0; g < ng; ++g)
+      for (Index n : group(g))
+        if (n >= 0) node_groups[fill[n]++] = g;
+  }
   for (Index n = 0; n < nn; ++n)
     if (held[n]) held_nodes_.push_back(n);
 
@@ -162,17 +182,22 @@ void Decomposition::rebuild_nodes() {
       ghost_only_nodes_.push_back(n);
     }
   // Send: nodes owned here to every rank holding them without touching
-  // them. Rank q holds n when it touches a node of an element of n's star.
+  // them. Rank q holds n when it touches a node of an element of n's star or
+  // of a group holding n.
   std::vector<int> holders;
+  auto add_ranks_of = [&](Index m) {
+    if (m < 0) return;
+    for (Index q = node_rank_offsets_[m]; q < node_rank_offsets_[m + 1]; ++q) holders.push_back(node_ranks_[q]);
+  };
   for (Index n : touched_nodes_) {
     if (node_owner(n) != rank_) continue;
     holders.clear();
     for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p) {
       const Index* c = mesh.element(mesh.node_elem[p]);
-      for (int a = 0; a < k; ++a)
-        for (Index q = node_rank_offsets_[c[a]]; q < node_rank_offsets_[c[a] + 1]; ++q)
-          holders.push_back(node_ranks_[q]);
+      for (int a = 0; a < k; ++a) add_ranks_of(c[a]);
     }
+    for (Index p = group_offsets[n]; p < group_offsets[n + 1]; ++p)
+      for (Index m : group(node_groups[p])) add_ranks_of(m);
     std::sort(holders.begin(), holders.end());
     holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
     for (int q : holders)
@@ -269,21 +294,39 @@ std::string Decomposition::broadcast(std::string text, int root) const {
   return text;
 }
 
+namespace {
+
+template <class T>
+std::vector<T> allgather_of(std::span<const T> mine, MPI_Datatype type, MPI_Comm comm, int ranks) {
+  std::vector<int> counts(ranks), displs(ranks, 0);
+  const int n = static_cast<int>(mine.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < ranks; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<T> all(displs[ranks - 1] + counts[ranks - 1]);
+  MPI_Allgatherv(mine.data(), n, type, all.data(), counts.data(), displs.data(), type, comm);
+  return all;
+}
+
+}  // namespace
+
 std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   static_assert(sizeof(Index) == sizeof(int));
-  std::vector<int> counts(size_), displs(size_, 0);
-  const int n = static_cast<int>(mine.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  for (int r = 1; r < size_; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<Index> all(displs[size_ - 1] + counts[size_ - 1]);
-  MPI_Allgatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, comm_);
-  return all;
+  return allgather_of(mine, MPI_INT, comm_, size_);
+}
+
+std::vector<double> Decomposition::allgather(std::span<const double> mine) const {
+  if (size_ == 1) return {mine.begin(), mine.end()};
+  return allgather_of(mine, MPI_DOUBLE, comm_, size_);
 }
 
 double Decomposition::min(double value) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MIN, comm_);
   return value;
+}
+
+void Decomposition::min(std::span<double> values) const {
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MIN, comm_);
 }
 
 int Decomposition::rank_of_min(double value) const {

@@ -70,8 +70,13 @@ class Decomposition {
   Decomposition(const Decomposition&) = delete;
   Decomposition& operator=(const Decomposition&) = delete;
 
-  /// Recompute the node lists after node splitting (granule ownership stays).
-  void rebuild_nodes();
+  /// Recompute the node lists after node splitting or cohesive insertion
+  /// (granule ownership stays). `groups`: node groups of `group_width` ids
+  /// each (negative ids skipped), the cohesive elements' side nodes: a rank
+  /// also holds, and receives from their owners, the nodes of every group
+  /// with a node it touches (it computes those groups' forces;
+  /// docs/parallel.md "Cohesive elements on ranks").
+  void rebuild_nodes(std::span<const Index> groups = {}, int group_width = 1);
 
   int rank() const { return rank_; }
   int size() const { return size_; }
@@ -84,7 +89,7 @@ class Decomposition {
   std::span<const Index> owned_granules() const { return owned_granules_; }
   /// Owned elements and the ghost layer, ascending.
   std::span<const Index> local_elements() const { return local_elements_; }
-  /// Nodes of local_elements(), ascending.
+  /// Nodes of local_elements() and of the groups with a touched node (rebuild_nodes), ascending.
   std::span<const Index> held_nodes() const { return held_nodes_; }
   /// Nodes of owned elements (integrated here), ascending.
   std::span<const Index> touched_nodes() const { return touched_nodes_; }
@@ -144,8 +149,11 @@ class Decomposition {
   std::string broadcast(std::string text, int root) const;
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
+  std::vector<double> allgather(std::span<const double> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
+  /// In place: the element-wise global minima.
+  void min(std::span<double> values) const;
   /// The smallest rank holding the global minimum of `value`.
   int rank_of_min(double value) const;
   /// Element-wise sums over the ranks, on every rank.

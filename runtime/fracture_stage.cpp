@@ -71,9 +71,25 @@ std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
   return out;
 }
 
+void FractureStage::share_with(const Decomposition& dec) {
+  if (!labeler_) labeler_ = std::make_unique<FragmentLabels>(model_, topology_, dec);
+  computed_.clear();
+  owned_.clear();
+  if (!dec.distributed()) return;
+  std::vector<char> touched(model_.mesh.num_nodes(), 0);
+  for (Index n : dec.touched_nodes()) touched[n] = 1;
+  for (Index c = 0; c < cohesive_.size(); ++c) {
+    const Index* nodes = cohesive_.side_nodes.data() + static_cast<size_t>(c) * kCohesiveSlots;
+    if (std::none_of(nodes, nodes + kCohesiveSlots, [&](Index n) { return n >= 0 && touched[n]; })) continue;
+    computed_.push_back(c);
+    owned_.push_back(dec.owns_element(topology_.facet_elem[cohesive_.facet[c]][0]) ? 1 : 0);
+  }
+  // (A rank owning a cohesive element touches its first element's nodes: it computes it.)
+}
+
 CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3> f_int) {
   if (cohesive_.size() == 0) return {};
-  return cohesive_forces(model_.mesh, topology_, cohesive_, laws(), x, f_int);
+  return cohesive_forces(model_.mesh, topology_, cohesive_, laws(), x, f_int, share());
 }
 
 std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6,
@@ -89,40 +105,48 @@ Insertion FractureStage::insert(std::span<const Index> facets) {
   return insert_cohesive_elements(model_.mesh, topology_, cohesive_, facets);
 }
 
-std::vector<Index> FractureStage::cohesive_nodes() const {
-  const int k = model_.mesh.order == 1 ? 3 : 6;
-  std::vector<Index> nodes;
-  nodes.reserve(static_cast<size_t>(cohesive_.size()) * 2 * k);
-  for (Index c = 0; c < cohesive_.size(); ++c)
-    for (int s = 0; s < 2; ++s)
-      for (int j = 0; j < k; ++j) nodes.push_back(cohesive_.side_nodes[(2 * static_cast<size_t>(c) + s) * 6 + j]);
-  std::sort(nodes.begin(), nodes.end());
-  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-  return nodes;
-}
-
-double FractureStage::stable_dt(double element_dt, std::span<const double> mass) {
-  if (cohesive_.size() == 0) return element_dt;
+double FractureStage::eigenvalue_bound(std::span<const double> mass) {
+  if (cohesive_.size() == 0) return 0;
   const std::array<Index, 3> key = {cohesive_.size(), model_.mesh.num_nodes(), released_};
   if (key != bound_key_) {
-    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws(), mass);
+    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws(), mass, share());
     bound_key_ = key;
   }
-  const double omega_e = 2.0 / element_dt;
-  return 2.0 / std::sqrt(omega_e * omega_e + eigenvalue_bound_);
+  return eigenvalue_bound_;
 }
 
-Index FractureStage::release(std::span<const Vec3> x) {
-  if (cohesive_.size() == 0) return 0;
-  const Index freed = release_debonded(model_.mesh, topology_, cohesive_, laws(), x);
+std::vector<Index> FractureStage::debonded(std::span<const Vec3> x) const {
+  if (cohesive_.size() == 0) return {};
+  return debonded_facets(model_.mesh, topology_, cohesive_, laws(), x, share());
+}
+
+Index FractureStage::release(std::span<const Index> facets) {
+  for (Index f : facets) topology_.facet_state[f] = FacetState::free;
+  const Index freed = static_cast<Index>(facets.size());
   released_ += freed;  // freed facets exert no force: the eigenvalue bound's key changes
   if (freed > 0) ++facet_revision_;
   return freed;
 }
 
+std::vector<double> FractureStage::owned_delta_max(const CohesiveElements& from, std::vector<Index>& rows) const {
+  rows.clear();
+  const bool all = computed_.empty();
+  const Index n = all ? from.size() : static_cast<Index>(computed_.size());
+  std::vector<double> values;
+  // (Elements are appended: those of an earlier state keep their index and owner.)
+  for (Index i = 0; i < n; ++i) {
+    const Index c = all ? i : computed_[i];
+    if (c >= from.size() || (!all && !owned_[i])) continue;
+    rows.push_back(c);
+    const double* d = from.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+    values.insert(values.end(), d, d + kCohesivePoints);
+  }
+  return values;
+}
+
 const Fragments& FractureStage::fragment_labels() const {
   if (labels_revision_ != facet_revision_) {
-    labels_ = label_fragments(model_.mesh, topology_);
+    labels_ = labeler_->label(topology_);
     labels_revision_ = facet_revision_;
   }
   return labels_;

@@ -11,6 +11,8 @@
 
 #include "fracture/cohesive_elements.hpp"
 #include "fracture/fragments.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/fragment_labels.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {
@@ -62,7 +64,18 @@ class FractureStage {
   /// with both lengths; the run goes on.
   std::vector<std::string> cohesive_zone_warnings() const;
 
-  /// Adds cohesive forces dE/dx at positions x to f_int; returns the energies.
+  /// This rank's share of the cohesive elements (docs/parallel.md "Cohesive
+  /// elements on ranks"): it computes those with a node it touches and owns
+  /// those whose facet's first element (smaller global id) it owns. Call
+  /// after every insertion, split or restore, once `dec` knows the nodes.
+  void share_with(const Decomposition& dec);
+  /// The cohesive elements' side nodes, kCohesiveSlots per element (-1 for
+  /// unused slots): the node groups of Decomposition::rebuild_nodes.
+  std::span<const Index> side_nodes() const { return cohesive_.side_nodes; }
+
+  /// Adds the forces dE/dx at positions x of the cohesive elements this rank
+  /// computes to f_int (the nodes it touches get every term); returns the
+  /// energies of those it owns.
   CohesiveEnergy add_forces(std::span<const Vec3> x, std::span<Vec3> f_int);
 
   /// Facets whose traction (from the elements' Cauchy stresses, 6 Voigt
@@ -75,33 +88,41 @@ class FractureStage {
   /// order given); nodes split. Returns what changed (new nodes to fill in by
   /// the caller).
   Insertion insert(std::span<const Index> facets);
-  /// The nodes of all cohesive elements (both sides), ascending.
-  std::vector<Index> cohesive_nodes() const;
   const Topology& topology() const { return topology_; }
   /// The facet of each cohesive element.
   std::span<const Index> cohesive_facets() const { return cohesive_.facet; }
 
-  /// Stable step of the volume and cohesive elements together, s (no safety
-  /// factor): 2 / sqrt((2 / element_dt)^2 + lambda_c), lambda_c the bound of
-  /// cohesive_eigenvalue_bound for the lumped masses `mass` (kg, per node),
-  /// recomputed when cohesive elements or nodes were added since the last call.
-  double stable_dt(double element_dt, std::span<const double> mass);
+  /// The bound lambda_c of cohesive_eigenvalue_bound for the lumped masses
+  /// `mass` (kg, per node), 1/s^2, over the cohesive elements computed here
+  /// (the largest over the ranks is the whole model's), recomputed when
+  /// cohesive elements or nodes were added or facets freed since the last
+  /// call. The stable step of the volume and cohesive elements together is
+  /// 2 / sqrt((2 / element_dt)^2 + lambda_c) (no safety factor).
+  double eigenvalue_bound(std::span<const double> mass);
 
-  /// Frees fully debonded facets not in compression at positions x (release_debonded); returns how
-  /// many.
-  Index release(std::span<const Vec3> x);
+  /// The facets among those owned here that are fully debonded and not in
+  /// compression at positions x (debonded_facets), to free on every rank.
+  std::vector<Index> debonded(std::span<const Vec3> x) const;
+  /// Frees `facets` (every rank's debonded(), the same list everywhere); returns how many.
+  Index release(std::span<const Index> facets);
+  /// The delta_max in `from` (a saved state, FractureState::cohesive) of the
+  /// cohesive elements owned here (rows: their indices, ascending;
+  /// kCohesivePoints values per row), for a checkpoint's gather.
+  std::vector<double> owned_delta_max(const CohesiveElements& from, std::vector<Index>& rows) const;
 
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
   }
-  /// The fragments' element ids and count (no statistics: no positions
-  /// needed). Recomputed (label_fragments, O(elements + facets)) only after
-  /// facets were freed or the state restored: nothing else changes them.
+  /// The fragments' element ids (of the owned elements and their facet
+  /// neighbours) and the whole model's count (no statistics: no positions
+  /// needed; FragmentLabels, collective). Recomputed only after facets were
+  /// freed or the state restored: nothing else changes them.
   const Fragments& fragment_labels() const;
   Index cohesive_count() const { return cohesive_.size(); }
-  /// The crack surface (crack_area) with the fragments `frags` of the current state.
+  /// The crack surface (crack_area) of the cohesive elements owned here, with
+  /// the fragments `frags` of the current state (to sum over the ranks).
   CrackArea crack_area(const Fragments& frags) const {
-    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws(), frags.elem_fragment);
+    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws(), frags.elem_fragment, share());
   }
   /// Per element damage in [0, 1] (element_damage), for output.
   std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws()); }
@@ -125,8 +146,13 @@ class FractureStage {
   std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
   double weakest_facet_ = 0;            ///< min of facet_strength_, Pa
   FractureLaws laws() const { return {laws_, facet_strength_, weakest_facet_}; }
+  /// share_with's lists (empty on one rank: every element, all owned).
+  std::vector<Index> computed_;
+  std::vector<std::uint8_t> owned_;
+  CohesiveShare share() const { return {computed_, owned_}; }
   double check_seconds_ = 0;
   long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
+  std::unique_ptr<FragmentLabels> labeler_;  ///< from the first share_with
   mutable Fragments labels_;
   mutable long labels_revision_ = -1;  ///< facet_revision_ of labels_
   double eigenvalue_bound_ = 0;  ///< cached cohesive bound, 1/s^2

@@ -87,22 +87,21 @@ double Simulation::next_dt() {
 }
 
 void Simulation::compute_forces(long step, double time, const std::function<void()>& between) {
-  if (cohesive_nodes_) {
-    const std::span<Vec3> arrays[] = {x_};
-    timed(comm_seconds_, [&] { dec_->share(*cohesive_nodes_, arrays); });
-  }
   // `between` (the end of the ghost update) is timed as communication.
   const double comm_before = comm_seconds_;
   timed(element_seconds_, [&] { last_elements_ = elements_.compute(x_, f_int_, stress6_, between); });
   element_seconds_ -= comm_seconds_ - comm_before;
-  if (fracture_) {
-    const CohesiveEnergy ce = fracture_->add_forces(x_, f_int_);
-    ledger_.cohesive_stored = ce.stored;
-    ledger_.cohesive_dissipated = ce.dissipated;
-  }
-  // With cohesive elements the stable step also bounds their stiffness.
-  stable_dt_ = dec_->min(fracture_ ? fracture_->stable_dt(last_elements_.stable_dt, model_.mass)
-                                   : last_elements_.stable_dt);
+  // The cohesive elements' nodes are held here and current (the ghost update
+  // brings them: Decomposition::rebuild_nodes' groups); update_ledger sums
+  // their energies over the ranks.
+  if (fracture_) cohesive_energy_ = fracture_->add_forces(x_, f_int_);
+  // With cohesive elements the stable step also bounds their stiffness:
+  // 2 / sqrt(omega_e^2 + lambda_c), both over the whole model.
+  double dt_bound[2] = {last_elements_.stable_dt, fracture_ ? -fracture_->eigenvalue_bound(model_.mass) : 0.0};
+  dec_->min(dt_bound);
+  const double omega_e = 2.0 / dt_bound[0];
+  stable_dt_ = fracture_ && fracture_->cohesive_count() > 0 ? 2.0 / std::sqrt(omega_e * omega_e - dt_bound[1])
+                                                           : dt_bound[0];
   if (dec_->distributed()) {
     // The worst element over all ranks (NaN first, then the smallest det F,
     // then the smallest index, as on one rank).
@@ -251,9 +250,9 @@ void Simulation::correct(const std::vector<Vec3>& reaction_old) {
 }
 
 void Simulation::apply_fracture() {
-  // Every rank holds the positions of every cohesive node (compute_forces),
-  // so releases are the same everywhere.
-  fracture_->release(x_);
+  // A cohesive element is freed by its owner, which computes it; every rank
+  // frees the same list.
+  fracture_->release(dec_->allgather(fracture_->debonded(x_)));
   // A facet is checked by the owner of its smaller element, which holds both
   // elements' stresses; every rank inserts the same list.
   std::vector<Index> critical = dec_->distributed() ? dec_->allgather(fracture_->check(
@@ -267,6 +266,7 @@ void Simulation::apply_fracture() {
     grow_nodes(ins.new_nodes);
     if (contact_) contact_->rebuild(model_.mesh);
   }
+  dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
   share_plans();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
@@ -275,11 +275,10 @@ void Simulation::apply_fracture() {
 }
 
 void Simulation::share_plans() {
+  if (fracture_) fracture_->share_with(*dec_);
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
-  auto plan = [&](std::vector<Index> nodes) { return std::make_unique<SharedNodes>(dec_->shared_nodes(std::move(nodes))); };
-  if (contact_) surface_nodes_ = plan(contact_->surface().vertices);
-  if (fracture_ && fracture_->cohesive_count() > 0) cohesive_nodes_ = plan(fracture_->cohesive_nodes());
+  if (contact_) surface_nodes_ = std::make_unique<SharedNodes>(dec_->shared_nodes(contact_->surface().vertices));
 }
 
 void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {
@@ -310,7 +309,6 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
     inv_mass_[i] = 1.0 / model_.mass[i];
     if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
-  dec_->rebuild_nodes();
 }
 
 void Simulation::node_arrays_from_model() {
@@ -332,7 +330,9 @@ void Simulation::update_ledger() {
   // Per owned granule over its home nodes, exact over the granules, the
   // step's work, then over the ranks: the same bits for any decomposition
   // and thread count.
-  constexpr int kKinetic = 0, kP = 1, kL = 4, kStrain = 7, kLocal = 8, kSums = kLocal + int{kStepWorks};
+  constexpr int kKinetic = 0, kP = 1, kL = 4, kStrain = 7, kStored = 8, kDissipated = 9, kLocal = 10,
+                kSums = kLocal + int{kStepWorks};
+  static_assert(kSums == kLedgerSums);
   const std::array<ExactSum, kStrain> nodes = granule_sums<kStrain>([&](Index i, std::array<double, kStrain>& s) {
     const Vec3 p = model_.mass[i] * v_[i], L = x_[i].cross(p);
     s[kKinetic] += 0.5 * p.dot(v_[i]);
@@ -341,6 +341,8 @@ void Simulation::update_ledger() {
   std::array<ExactSum, kSums> t;
   std::copy(nodes.begin(), nodes.end(), t.begin());
   for (Index gr : dec_->owned_granules()) t[kStrain] += elements_.granule_energy(gr);
+  t[kStored] = cohesive_energy_.stored;
+  t[kDissipated] = cohesive_energy_.dissipated;
   std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);
   step_work_ = {};
   timed(comm_seconds_, [&] { dec_->sum(t); });
@@ -348,6 +350,8 @@ void Simulation::update_ledger() {
   ledger_.momentum = Vec3(t[kP].value(), t[kP + 1].value(), t[kP + 2].value());
   ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());
   ledger_.strain = t[kStrain].value();
+  ledger_.cohesive_stored = t[kStored].value();
+  ledger_.cohesive_dissipated = t[kDissipated].value();
   ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value();
   ledger_.contact_work += t[kLocal + kContactWork].value();
   // Energy errors are relative to the largest energy the model has held.

@@ -182,6 +182,10 @@ class Simulation {
   /// over the ranks by update_ledger: gravity's work, the reactions' work and
   /// the contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work).
   enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
+  /// Accumulators of update_ledger's one reduction per step: kinetic energy,
+  /// momentum (3), angular momentum (3), strain, cohesive stored and
+  /// dissipated, and the step's works.
+  static constexpr int kLedgerSums = 10 + kStepWorks;
 
   Model& model_;
   RunOptions opt_;
@@ -189,7 +193,6 @@ class Simulation {
   ElementForces elements_;
   std::array<ExactSum, kStepWorks> step_work_;  ///< since the last update_ledger(), this rank's part
   std::unique_ptr<SharedNodes> surface_nodes_;   ///< contact surface vertices shared by all ranks
-  std::unique_ptr<SharedNodes> cohesive_nodes_;  ///< cohesive element nodes shared by all ranks
   /// After a topology change on several ranks: restrict the element loop to
   /// the local elements, renew the plans of the shared nodes.
   void share_plans();
@@ -213,6 +216,7 @@ class Simulation {
       contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block
   std::vector<double> stress6_;             ///< per element Cauchy stress for the facet check (fracture only)
+  CohesiveEnergy cohesive_energy_;          ///< of the cohesive elements owned here, at the last forces
   std::unique_ptr<FieldWriter> fields_;
   std::unique_ptr<CsvWriter> history_, bodies_;
   double stable_dt0_ = 0;  ///< stable step of the initial state (sets the default field interval)

@@ -139,6 +139,10 @@ CrackArea Simulation::write_fragments() {
   std::vector<ExactSum> sums = fragment_sums(model_.mesh, frags, dec_->owned_nodes(), dec_->owned_element_ids(), x_,
                                              v_, model_.mass);
   if (dec_->distributed()) reduce_to_root(sums, dec_->comm());
+  // The crack areas of each rank's owned cohesive elements, summed exactly.
+  const CrackArea owned = fracture_->crack_area(frags);
+  ExactSum areas[] = {owned.debonded, owned.between_fragments, owned.debonded_dissipated};
+  dec_->sum(areas);
   if (dec_->rank() != 0) return {};
   set_fragment_stats(frags, sums);
   CsvWriter out(opt_.out_dir / "fragments.csv",
@@ -149,7 +153,7 @@ CrackArea Simulation::write_fragments() {
         << s.velocity.x() << s.velocity.y() << s.velocity.z() << static_cast<long>(s.elements);
     out.end_row();
   }
-  return fracture_->crack_area(frags);
+  return {areas[0], areas[1], areas[2]};
 }
 
 long Simulation::loop_bytes() const {
@@ -186,7 +190,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
   j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
   // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
-  j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(8 + kStepWorks) : 0));
+  j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(kLedgerSums) : 0));
   // The contact stage's exchanges included (contact_exchange_time).
   j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
   j.add("nodes", static_cast<long>(model_.whole_nodes()));
@@ -216,9 +220,9 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
       across += dec_->granule_rank(fe[0] / ElementForces::kGranule) != dec_->granule_rank(fe[1] / ElementForces::kGranule);
     }
     j.add("cohesive_elements_across_ranks", across);
-    j.add("crack_area_debonded", crack.debonded);
-    j.add("crack_area_between_fragments", crack.between_fragments);
-    j.add("cohesive_dissipated_debonded", crack.debonded_dissipated);
+    j.add("crack_area_debonded", crack.debonded.value());
+    j.add("crack_area_between_fragments", crack.between_fragments.value());
+    j.add("cohesive_dissipated_debonded", crack.debonded_dissipated.value());
   }
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());

@@ -8,6 +8,7 @@
 #include "runtime/contact_stage.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/row_blocks.hpp"
 #include "runtime/simulation.hpp"
 #include "runtime/timed.hpp"
 
@@ -29,6 +30,16 @@ void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationSt
       s.reaction.clear();
       for (size_t i = 0; i < whole[6].size(); ++i)
         if (whole[6][i].x() != 0) s.reaction.push_back(whole[5][i]);
+    }
+    if (fracture_) {
+      // Each cohesive element's delta_max from its owner, which computes it.
+      std::vector<Index> rows;
+      const std::vector<double> mine = fracture_->owned_delta_max(s.fracture->cohesive, rows);
+      std::vector<double> all;
+      timed(comm_seconds_, [&] {
+        all = to_root(rows, mine, kCohesivePoints, s.fracture->cohesive.size(), dec_->comm());
+      });
+      if (dec_->rank() == 0) s.fracture->cohesive.delta_max = std::move(all);
     }
   }
   std::string failure;
@@ -81,7 +92,7 @@ void Simulation::restore_state(const SimulationState& s) {
     const std::uint64_t built_revision = model_.mesh.revision;
     fracture_->restore(*s.fracture);
     node_arrays_from_model();
-    dec_->rebuild_nodes();
+    dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
     if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
     share_plans();
   }

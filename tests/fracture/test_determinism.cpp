@@ -107,11 +107,11 @@ TEST(Determinism, FacetCheckAndCohesiveForcesForAnyThreadCount) {
     if (threads == 1) {
       reference_force = f;
       reference_energy = energy;
-      EXPECT_GT(energy.dissipated, 0.0);
+      EXPECT_GT(energy.dissipated.value(), 0.0);
     } else {
       EXPECT_TRUE(f == reference_force) << threads << " threads";  // bitwise
-      EXPECT_EQ(energy.stored, reference_energy.stored);
-      EXPECT_EQ(energy.dissipated, reference_energy.dissipated);
+      EXPECT_EQ(energy.stored.value(), reference_energy.stored.value());
+      EXPECT_EQ(energy.dissipated.value(), reference_energy.dissipated.value());
     }
   }
   EXPECT_GT(ins.new_nodes.size(), 0u);

@@ -14,6 +14,7 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
+#include "runtime/fragment_labels.hpp"
 #include "runtime/model.hpp"
 #include "scene_text.hpp"
 
@@ -152,6 +153,45 @@ TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
   d.sum({&total, 1});
   EXPECT_EQ(total.value(), whole.strain_energy);
   EXPECT_GT(total.value(), 0.0);
+}
+
+// The fragments merged across the ranks (FragmentLabels) are the serial
+// ones (label_fragments): the same count and, for every owned element and
+// every element sharing a facet with one, the same fragment id.
+TEST(Decomposition, FragmentLabelsOnRanksAreTheSerialOnes) {
+  const Model& m = box();
+  const Decomposition d(m, MPI_COMM_WORLD);
+  Topology topo = build_topology(m.mesh);
+  const FragmentLabels labels(m, topo, d);
+  for (int percent : {0, 30, 45, 60}) {
+    // Free a pseudo-random share of the interior facets (by global id, the
+    // same on every rank): from one piece through a percolating network to
+    // many small pieces.
+    for (Index f = 0; f < topo.num_facets(); ++f)
+      if (topo.is_interior(f))
+        topo.facet_state[f] = static_cast<int>((static_cast<std::uint64_t>(topo.facet_gid[f]) * 2654435761u) % 100) <
+                                      percent
+                                  ? FacetState::free
+                                  : FacetState::intact;
+    const Fragments serial = label_fragments(m.mesh, topo);
+    const Fragments merged = labels.label(topo);
+    ASSERT_EQ(merged.count(), serial.count()) << percent << " %";
+    long checked = 0, across = 0;
+    std::vector<int> fragment_rank(serial.count(), -1);
+    for (Index e = 0; e < m.mesh.num_elements(); ++e) {
+      int& r = fragment_rank[serial.elem_fragment[e]];
+      if (r >= 0 && r != d.element_rank(e)) ++across;
+      r = d.element_rank(e);
+      if (merged.elem_fragment[e] < 0) continue;
+      EXPECT_EQ(merged.elem_fragment[e], serial.elem_fragment[e]) << "element " << e << ", " << percent << " %";
+      ++checked;
+    }
+    EXPECT_GE(checked, d.owned_elements());
+    // On several ranks some fragments span ranks: the merge is exercised.
+    if (d.distributed()) EXPECT_GT(across, 0) << percent << " %";
+    if (percent == 0) EXPECT_EQ(serial.count(), 1);
+    if (percent == 60) EXPECT_GT(serial.count(), 100);
+  }
 }
 
 TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
