@@ -188,9 +188,15 @@ TEST(Decomposition, FragmentLabelsOnRanksAreTheSerialOnes) {
     }
     EXPECT_GE(checked, d.owned_elements());
     // On several ranks some fragments span ranks: the merge is exercised.
-    if (d.distributed()) EXPECT_GT(across, 0) << percent << " %";
-    if (percent == 0) EXPECT_EQ(serial.count(), 1);
-    if (percent == 60) EXPECT_GT(serial.count(), 100);
+    if (d.distributed()) {
+      EXPECT_GT(across, 0) << percent << " %";
+    }
+    if (percent == 0) {
+      EXPECT_EQ(serial.count(), 1);
+    }
+    if (percent == 60) {
+      EXPECT_GT(serial.count(), 100);
+    }
   }
 }
 
