@@ -20,6 +20,7 @@
 #include <memory>
 #include <random>
 
+#include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/model.hpp"
@@ -33,6 +34,7 @@ constexpr double kStrength = 300.0e6;
 
 struct Setup {
   std::unique_ptr<Model> model;
+  std::unique_ptr<Decomposition> dec;       // one rank: MPI is not initialised
   std::unique_ptr<FractureStage> fracture;  // the runtime's topology, laws and check
   std::vector<Vec3> x;
 };
@@ -53,7 +55,8 @@ Setup& setup() {
     // The check reads sigma_c and beta only. Gc = 1000 J/m^2 (not the ring's
     // 100) so that the elastic rise sigma_c / k_p, with k_p = E / h_min as the
     // runtime sets it, ends before delta_c on this coarse (4 mm) mesh.
-    s.fracture = std::make_unique<FractureStage>(*s.model);
+    s.dec = std::make_unique<Decomposition>(*s.model, MPI_COMM_SELF);
+    s.fracture = std::make_unique<FractureStage>(*s.model, *s.dec);
     s.x = s.model->mesh.reference;
     for (Vec3& p : s.x) p = Vec3(1.001 * p.x(), 0.9997 * p.y(), 0.9997 * p.z());
   }

@@ -320,6 +320,12 @@ std::vector<double> Decomposition::allgather(std::span<const double> mine) const
   return allgather_of(mine, MPI_DOUBLE, comm_, size_);
 }
 
+std::vector<GlobalId> Decomposition::allgather(std::span<const GlobalId> mine) const {
+  if (size_ == 1) return {mine.begin(), mine.end()};
+  static_assert(sizeof(GlobalId) == sizeof(std::int64_t));
+  return allgather_of(mine, MPI_INT64_T, comm_, size_);
+}
+
 double Decomposition::min(double value) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MIN, comm_);
   return value;

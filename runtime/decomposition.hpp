@@ -150,6 +150,7 @@ class Decomposition {
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
   std::vector<double> allgather(std::span<const double> mine) const;
+  std::vector<GlobalId> allgather(std::span<const GlobalId> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
   /// In place: the element-wise global minima.

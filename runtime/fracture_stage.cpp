@@ -12,16 +12,19 @@
 
 namespace shatter {
 
-FractureStage::FractureStage(Model& model) : model_(model), topology_(build_topology(model.mesh)) {
+FractureStage::FractureStage(Model& model, const Decomposition& dec)
+    : model_(model), dec_(dec), topology_(build_topology(model.mesh)) {
   const Mesh& mesh = model.mesh;
   const size_t nm = model.scene.materials.size();
+  // The whole model's smallest altitude per material, from the owned elements.
   std::vector<double> h_min(nm, HUGE_VAL);
-  for (Index e = 0; e < mesh.num_elements(); ++e) {
+  for (Index e : dec.owned_element_ids()) {
     const Index* c = mesh.element(e);
     const auto& X = mesh.reference;
     h_min[mesh.elem_material[e]] =
         std::min(h_min[mesh.elem_material[e]], tet_min_altitude(X[c[0]], X[c[1]], X[c[2]], X[c[3]]));
   }
+  dec.min(h_min);
   std::vector<std::optional<StrengthScatter>> scatter(nm);
   for (size_t m = 0; m < nm; ++m) {
     const MaterialSpec& ms = model.scene.materials[m];
@@ -37,14 +40,37 @@ FractureStage::FractureStage(Model& model) : model_(model), topology_(build_topo
     facet_strength_ = facet_strengths(mesh, topology_, laws_, scatter);
     weakest_facet_ = *std::min_element(facet_strength_.begin(), facet_strength_.end());
   }
+  // The interior facets by global id, for the lists every rank applies.
+  for (Index f = 0; f < topology_.num_facets(); ++f)
+    if (topology_.is_interior(f)) by_gid_.push_back(f);
+  std::sort(by_gid_.begin(), by_gid_.end(),
+            [&](Index a, Index b) { return topology_.facet_gid[a] < topology_.facet_gid[b]; });
+}
+
+std::vector<GlobalId> FractureStage::gids(std::span<const Index> facets) const {
+  std::vector<GlobalId> out;
+  out.reserve(facets.size());
+  for (Index f : facets) out.push_back(topology_.facet_gid[f]);
+  return out;
+}
+
+std::vector<Index> FractureStage::facets(std::span<const GlobalId> gids) const {
+  std::vector<Index> out;
+  for (GlobalId g : gids) {
+    const auto it = std::lower_bound(by_gid_.begin(), by_gid_.end(), g,
+                                     [&](Index f, GlobalId v) { return topology_.facet_gid[f] < v; });
+    if (it != by_gid_.end() && topology_.facet_gid[*it] == g) out.push_back(*it);
+  }
+  return out;
 }
 
 std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
+  // The mean longest edge per material over the whole model, from the owned elements.
   const Mesh& mesh = model_.mesh;
   const size_t nm = model_.scene.materials.size();
-  std::vector<double> edge_sum(nm, 0.0);
-  std::vector<Index> count(nm, 0);
-  for (Index e = 0; e < mesh.num_elements(); ++e) {
+  std::vector<ExactSum> edge_sum(nm);
+  std::vector<long> count(nm, 0);
+  for (Index e : dec_.owned_element_ids()) {
     const Index* c = mesh.element(e);
     double longest = 0;
     for (int a = 0; a < 4; ++a)
@@ -53,11 +79,13 @@ std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
     edge_sum[mesh.elem_material[e]] += longest;
     ++count[mesh.elem_material[e]];
   }
+  dec_.sum(edge_sum);
+  count = dec_.sum(count);
   std::vector<std::string> out;
   for (size_t m = 0; m < nm; ++m) {
     const MaterialSpec& ms = model_.scene.materials[m];
     if (!ms.fracture || count[m] == 0) continue;
-    const double h = edge_sum[m] / count[m];
+    const double h = edge_sum[m].value() / count[m];
     const double l_cz = ms.young * ms.fracture->energy / (ms.fracture->strength * ms.fracture->strength);
     if (l_cz >= kCohesiveZoneElements * h) continue;
     char buf[400];
@@ -71,8 +99,9 @@ std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
   return out;
 }
 
-void FractureStage::share_with(const Decomposition& dec) {
-  if (!labeler_) labeler_ = std::make_unique<FragmentLabels>(model_, topology_, dec);
+void FractureStage::share() {
+  const Decomposition& dec = dec_;
+  if (!labeler_) labeler_ = std::make_unique<FragmentLabels>(model_, topology_, dec_);
   computed_.clear();
   owned_.clear();
   if (!dec.distributed()) return;
@@ -89,7 +118,7 @@ void FractureStage::share_with(const Decomposition& dec) {
 
 CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3> f_int) {
   if (cohesive_.size() == 0) return {};
-  return cohesive_forces(model_.mesh, topology_, cohesive_, laws(), x, f_int, share());
+  return cohesive_forces(model_.mesh, topology_, cohesive_, laws(), x, f_int, mine());
 }
 
 std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6,
@@ -109,7 +138,7 @@ double FractureStage::eigenvalue_bound(std::span<const double> mass) {
   if (cohesive_.size() == 0) return 0;
   const std::array<Index, 3> key = {cohesive_.size(), model_.mesh.num_nodes(), released_};
   if (key != bound_key_) {
-    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws(), mass, share());
+    eigenvalue_bound_ = cohesive_eigenvalue_bound(model_.mesh, topology_, cohesive_, laws(), mass, mine());
     bound_key_ = key;
   }
   return eigenvalue_bound_;
@@ -117,7 +146,7 @@ double FractureStage::eigenvalue_bound(std::span<const double> mass) {
 
 std::vector<Index> FractureStage::debonded(std::span<const Vec3> x) const {
   if (cohesive_.size() == 0) return {};
-  return debonded_facets(model_.mesh, topology_, cohesive_, laws(), x, share());
+  return debonded_facets(model_.mesh, topology_, cohesive_, laws(), x, mine());
 }
 
 Index FractureStage::release(std::span<const Index> facets) {

@@ -53,7 +53,10 @@ class FractureStage {
   /// adjacent elements, not a user knob; stable_dt() accounts for it. With
   /// strength scatter, each facet's strength is drawn here from its global id
   /// (facet_strengths).
-  explicit FractureStage(Model& model);
+  /// `dec`: how the ranks share the model (the penalty's h_min and the
+  /// cohesive-zone warning are over the whole model; the cohesive elements
+  /// and fragments are divided, share()).
+  FractureStage(Model& model, const Decomposition& dec);
 
   /// Elements the cohesive zone should span at least (Falk, Needleman & Rice,
   /// J. Phys. IV 11 (2001) Pr5-43: 2-5 elements for converged crack speeds).
@@ -61,14 +64,21 @@ class FractureStage {
   /// One warning per fracturing material whose cohesive zone length
   /// l_cz = E Gc / sigma_c^2 (Rice's estimate up to a factor of order 1) is
   /// shorter than kCohesiveZoneElements x its mean longest element edge h,
-  /// with both lengths; the run goes on.
+  /// with both lengths; the run goes on. Collective.
   std::vector<std::string> cohesive_zone_warnings() const;
 
   /// This rank's share of the cohesive elements (docs/parallel.md "Cohesive
   /// elements on ranks"): it computes those with a node it touches and owns
   /// those whose facet's first element (smaller global id) it owns. Call
-  /// after every insertion, split or restore, once `dec` knows the nodes.
-  void share_with(const Decomposition& dec);
+  /// after every insertion, split or restore, once the decomposition knows
+  /// the nodes.
+  void share();
+
+  /// Facet global ids (Topology::facet_gid) of `facets`, and back: the
+  /// interior facets held here among `gids` (others skipped). Facet lists
+  /// travel between ranks by global id.
+  std::vector<GlobalId> gids(std::span<const Index> facets) const;
+  std::vector<Index> facets(std::span<const GlobalId> gids) const;
   /// The cohesive elements' side nodes, kCohesiveSlots per element (-1 for
   /// unused slots): the node groups of Decomposition::rebuild_nodes.
   std::span<const Index> side_nodes() const { return cohesive_.side_nodes; }
@@ -122,7 +132,7 @@ class FractureStage {
   /// The crack surface (crack_area) of the cohesive elements owned here, with
   /// the fragments `frags` of the current state (to sum over the ranks).
   CrackArea crack_area(const Fragments& frags) const {
-    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws(), frags.elem_fragment, share());
+    return shatter::crack_area(model_.mesh, topology_, cohesive_, laws(), frags.elem_fragment, mine());
   }
   /// Per element damage in [0, 1] (element_damage), for output.
   std::vector<double> damage() const { return element_damage(model_.mesh, topology_, cohesive_, laws()); }
@@ -140,7 +150,9 @@ class FractureStage {
 
  private:
   Model& model_;
+  const Decomposition& dec_;
   Topology topology_;
+  std::vector<Index> by_gid_;  ///< interior facets, ascending by facet_gid
   CohesiveElements cohesive_;
   std::vector<std::optional<CohesiveLaw>> laws_;
   std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
@@ -149,7 +161,7 @@ class FractureStage {
   /// share_with's lists (empty on one rank: every element, all owned).
   std::vector<Index> computed_;
   std::vector<std::uint8_t> owned_;
-  CohesiveShare share() const { return {computed_, owned_}; }
+  CohesiveShare mine() const { return {computed_, owned_}; }
   double check_seconds_ = 0;
   long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
   std::unique_ptr<FragmentLabels> labeler_;  ///< from the first share_with

@@ -57,7 +57,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
   if (model_.scene.fracture_enabled()) {
-    fracture_ = std::make_unique<FractureStage>(model_);
+    fracture_ = std::make_unique<FractureStage>(model_, *dec_);
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
   }
   ledger_.fragments = static_cast<long>(model_.scene.bodies.size());
@@ -72,8 +72,9 @@ Simulation::Simulation(Model& model, RunOptions options)
   if (model_.scene.fixed_dt && *model_.scene.fixed_dt > stable_dt_ && dec_->rank() == 0)
     std::fprintf(stderr, "warning: %s: time.dt = %.3e s is above the stable step %.3e s; the run may blow up\n",
                  model_.scene.file.c_str(), *model_.scene.fixed_dt, stable_dt_);
-  if (fracture_ && dec_->rank() == 0)
-    for (const std::string& w : fracture_->cohesive_zone_warnings()) std::fprintf(stderr, "%s\n", w.c_str());
+  if (fracture_)
+    for (const std::string& w : fracture_->cohesive_zone_warnings())
+      if (dec_->rank() == 0) std::fprintf(stderr, "%s\n", w.c_str());
 }
 
 Simulation::~Simulation() = default;
@@ -250,14 +251,16 @@ void Simulation::correct(const std::vector<Vec3>& reaction_old) {
 }
 
 void Simulation::apply_fracture() {
-  // A cohesive element is freed by its owner, which computes it; every rank
-  // frees the same list.
-  fracture_->release(dec_->allgather(fracture_->debonded(x_)));
-  // A facet is checked by the owner of its smaller element, which holds both
-  // elements' stresses; every rank inserts the same list.
-  std::vector<Index> critical = dec_->distributed() ? dec_->allgather(fracture_->check(
-                                                          x_, stress6_, dec_->local_elements(), dec_->owned_element_ids()))
-                                                    : fracture_->check(x_, stress6_);
+  // A cohesive element is freed by its owner, which computes it; a facet is
+  // checked by the owner of its smaller element, which holds both elements'
+  // stresses. Every rank frees and inserts the gathered lists (by facet
+  // global id) where it holds the facets.
+  fracture_->release(fracture_->facets(dec_->allgather(fracture_->gids(fracture_->debonded(x_)))));
+  const std::vector<Index> critical =
+      dec_->distributed()
+          ? fracture_->facets(dec_->allgather(fracture_->gids(
+                fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids()))))
+          : fracture_->check(x_, stress6_);
   const Index before = fracture_->cohesive_count();
   const Insertion ins = fracture_->insert(critical);
   ledger_.cohesive_elements = fracture_->cohesive_count();
@@ -275,7 +278,7 @@ void Simulation::apply_fracture() {
 }
 
 void Simulation::share_plans() {
-  if (fracture_) fracture_->share_with(*dec_);
+  if (fracture_) fracture_->share();
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
   if (contact_) surface_nodes_ = std::make_unique<SharedNodes>(dec_->shared_nodes(contact_->surface().vertices));
