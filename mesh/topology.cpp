@@ -185,6 +185,24 @@ std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo,
     }
   }
   if (!created.empty()) {
+    // The new nodes in the order of their names, as every rank holding some
+    // of them orders them (whatever else it splits).
+    const Index first = created.front()[0], count = mesh.num_nodes() - first;
+    std::vector<Index> order(count), new_id(count);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(),
+              [&](Index a, Index b) { return mesh.node_gid[first + a] < mesh.node_gid[first + b]; });
+    for (Index i = 0; i < count; ++i) new_id[order[i]] = first + i;
+    auto permute = [&](auto& v) {
+      const auto old = v;
+      for (Index i = 0; i < count; ++i) v[first + i] = old[first + order[i]];
+    };
+    permute(mesh.reference);
+    permute(mesh.node_body);
+    permute(mesh.node_gid);
+    auto renamed = [&](Index n) { return n >= first ? new_id[n - first] : n; };
+    for (Index& n : mesh.conn) n = renamed(n);
+    for (auto& [copy, parent] : created) copy = renamed(copy), parent = renamed(parent);
     mesh.build_node_elements();
     ++mesh.revision;
   }

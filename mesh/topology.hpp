@@ -84,7 +84,9 @@ inline std::span<const Index> node_star(const Mesh& mesh, Index n) {
 /// named split_gid_base + 10 g + a + 1: such a name is given at most once, and
 /// every rank that holds the star derives the same name.
 /// Updates conn, reference, node_gid, node_body and the node -> element CSR,
-/// and bumps Mesh::revision when a node was created.
+/// and bumps Mesh::revision when a node was created. The new nodes follow the
+/// old ones in the order of their names, so that every rank holding some of
+/// them numbers them in the same relative order.
 /// Returns (new node, parent node) pairs in creation order; a parent may be a
 /// node created earlier in the same call.
 std::vector<std::array<Index, 2>> split_nodes(Mesh& mesh, const Topology& topo,
