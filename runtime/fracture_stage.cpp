@@ -100,18 +100,17 @@ std::vector<std::string> FractureStage::cohesive_zone_warnings() const {
 }
 
 void FractureStage::share() {
-  const Decomposition& dec = dec_;
   if (!labeler_) labeler_ = std::make_unique<FragmentLabels>(model_, topology_, dec_);
   computed_.clear();
   owned_.clear();
-  if (!dec.distributed()) return;
+  if (!dec_.distributed()) return;
   std::vector<char> touched(model_.mesh.num_nodes(), 0);
-  for (Index n : dec.touched_nodes()) touched[n] = 1;
+  for (Index n : dec_.touched_nodes()) touched[n] = 1;
   for (Index c = 0; c < cohesive_.size(); ++c) {
     const Index* nodes = cohesive_.side_nodes.data() + static_cast<size_t>(c) * kCohesiveSlots;
     if (std::none_of(nodes, nodes + kCohesiveSlots, [&](Index n) { return n >= 0 && touched[n]; })) continue;
     computed_.push_back(c);
-    owned_.push_back(dec.owns_element(topology_.facet_elem[cohesive_.facet[c]][0]) ? 1 : 0);
+    owned_.push_back(dec_.owns_element(topology_.facet_elem[cohesive_.facet[c]][0]) ? 1 : 0);
   }
   // (A rank owning a cohesive element touches its first element's nodes: it computes it.)
 }
