@@ -22,7 +22,7 @@ static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 pa
 
 constexpr const char* kFormat = "shatter-checkpoint";
 // 2: the step controller's state; 3: the scene's physics keys; 4: the ledger's contact_work
-constexpr long kVersion = 4;
+constexpr long kVersion = 5;
 constexpr long kOldestVersion = 2;  // read without the physics check
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
@@ -285,7 +285,8 @@ std::uintmax_t checkpoint_bytes(const SimulationState& s) {
     const FractureState& f = *s.fracture;
     const CohesiveElements& c = f.cohesive;
     bytes += bytes_of(f.reference, f.node_gid, f.node_body, f.conn, f.mass, f.bc_mask, f.bc_velocity,
-                      f.initial_velocity, f.facet_state, c.facet, c.side_local, c.side_nodes, c.area, c.normal,
+                      f.initial_velocity, f.facet_gid, f.facet_state, f.cohesive_facet_gid, c.side_local, c.side_nodes,
+                      c.area, c.normal,
                       c.delta_max);
   }
   return bytes;
@@ -393,7 +394,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       const hid_t fr = group.get();
       w.integer(fr, "nodes", static_cast<long>(f.reference.size()));
       w.integer(fr, "facets", static_cast<long>(f.facet_state.size()));
-      w.integer(fr, "cohesive_elements", f.cohesive.size());
+      w.integer(fr, "cohesive_elements", static_cast<long>(f.cohesive_facet_gid.size()));
       w.attribute(fr, "mesh_revision", H5T_NATIVE_UINT64, &f.mesh_revision);
       w.rows(fr, "reference", f.reference);
       w.array(fr, "node_gid", f.node_gid);
@@ -403,9 +404,10 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       w.array(fr, "bc_mask", f.bc_mask);
       w.rows(fr, "bc_velocity", f.bc_velocity);
       w.rows(fr, "initial_velocity", f.initial_velocity);
+      w.array(fr, "facet_gid", f.facet_gid);
       w.array(fr, "facet_state", f.facet_state);
       const CohesiveElements& c = f.cohesive;
-      w.array(fr, "cohesive_facet", c.facet);
+      w.array(fr, "cohesive_facet", f.cohesive_facet_gid);
       w.array(fr, "cohesive_side_local", c.side_local, kCohesiveSlots);
       w.array(fr, "cohesive_side_nodes", c.side_nodes, kCohesiveSlots);
       w.array(fr, "cohesive_area", c.area);
@@ -499,6 +501,10 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
             has_fracture ? "the checkpoint has a fracture state but the scene has no fracture block"
                          : "the scene has fracture but the checkpoint has no fracture state (written by an "
                            "older shatter?)");
+  r.require(!has_fracture || version >= 5,
+            "the fracture state is of format version " + std::to_string(version) +
+                " (facets by index); this shatter reads fracture states of version 5 on (facets by global id): "
+                "run the scene again from the start");
   if (has_fracture) {
     H5Handle group(H5Gopen2(root, "fracture", H5P_DEFAULT), H5Gclose);
     r.require(group.valid(), "group /fracture is unreadable (truncated or corrupted checkpoint?)");
@@ -518,10 +524,11 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
     f.bc_mask = r.array<std::uint8_t>(fr, "bc_mask", n);
     f.bc_velocity = r.rows(fr, "bc_velocity", n);
     f.initial_velocity = r.rows(fr, "initial_velocity", n);
+    f.facet_gid = r.array<GlobalId>(fr, "facet_gid", static_cast<std::size_t>(facets));
     f.facet_state = r.array<FacetState>(fr, "facet_state", static_cast<std::size_t>(facets));
     CohesiveElements& c = f.cohesive;
     const auto nc = static_cast<std::size_t>(cohesive);
-    c.facet = r.array<Index>(fr, "cohesive_facet", nc);
+    f.cohesive_facet_gid = r.array<GlobalId>(fr, "cohesive_facet", nc);
     c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots);
     c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots);
     c.area = r.array<double>(fr, "cohesive_area", nc);

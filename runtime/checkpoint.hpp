@@ -10,9 +10,10 @@
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
-//       version       int64 3 (2: without physics, scene_fingerprint and
-//                     history_every, read without the physics check; 1: before
-//                     the step controller, refused)
+//       version       int64 5 (4: /fracture's facets by index, refused with
+//                     fracture; 3: without the ledger's contact_work; 2: without
+//                     physics, scene_fingerprint and history_every, read without
+//                     the physics check; 1: before the step controller, refused)
 //       scene         string, Scene::name
 //       nodes         int64, nodes of the model as built (before fracture)
 //       elements      int64
@@ -48,12 +49,14 @@
 //       cohesive_elements, fragments, contact_capped_steps)
 //
 //   /fracture  only for scenes with fracture (FractureState, fracture_stage.hpp);
-//       attributes nodes (n), facets (f), cohesive_elements (c), mesh_revision;
+//       attributes nodes (n), facets (f: the interior facets that are not
+//       intact), cohesive_elements (c), mesh_revision;
 //       datasets, each with fnv1a64 like /state's:
 //       reference n x 3, node_gid n (int64), node_body n (int32),
 //       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3,
-//       initial_velocity n x 3, facet_state f (uint8: 0 intact, 1 cohesive,
-//       2 free), cohesive_facet c (int32), cohesive_side_local c x 12 (int8),
+//       initial_velocity n x 3, facet_gid f (int64: Topology::facet_gid,
+//       ascending), facet_state f (uint8: 1 cohesive, 2 free),
+//       cohesive_facet c (int64: facet gid), cohesive_side_local c x 12 (int8),
 //       cohesive_side_nodes c x 12 (int32), cohesive_area c, cohesive_normal
 //       c x 3, cohesive_delta_max c x 3 (m)
 //

@@ -156,17 +156,18 @@ Index FractureStage::release(std::span<const Index> facets) {
   return freed;
 }
 
-std::vector<double> FractureStage::owned_delta_max(const CohesiveElements& from, std::vector<Index>& rows) const {
+std::vector<double> FractureStage::owned_delta_max(const FractureState& from, std::vector<Index>& rows) const {
   rows.clear();
   const bool all = computed_.empty();
-  const Index n = all ? from.size() : static_cast<Index>(computed_.size());
+  const auto saved = static_cast<Index>(from.cohesive_facet_gid.size());
+  const Index n = all ? saved : static_cast<Index>(computed_.size());
   std::vector<double> values;
   // (Elements are appended: those of an earlier state keep their index and owner.)
   for (Index i = 0; i < n; ++i) {
     const Index c = all ? i : computed_[i];
-    if (c >= from.size() || (!all && !owned_[i])) continue;
+    if (c >= saved || (!all && !owned_[i])) continue;
     rows.push_back(c);
-    const double* d = from.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+    const double* d = from.cohesive.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
     values.insert(values.end(), d, d + kCohesivePoints);
   }
   return values;
@@ -193,8 +194,16 @@ void FractureStage::save(FractureState& s) const {
     s.bc_velocity = model_.bc_velocity;
     s.initial_velocity = model_.initial_velocity;
   }
-  s.facet_state = topology_.facet_state;
+  s.facet_gid.clear();
+  s.facet_state.clear();
+  for (Index f : by_gid_)
+    if (topology_.facet_state[f] != FacetState::intact) {
+      s.facet_gid.push_back(topology_.facet_gid[f]);
+      s.facet_state.push_back(topology_.facet_state[f]);
+    }
   s.cohesive = cohesive_;
+  s.cohesive.facet.clear();
+  s.cohesive_facet_gid = gids(cohesive_.facet);
 }
 
 void FractureStage::restore(const FractureState& s) {
@@ -206,21 +215,28 @@ void FractureStage::restore(const FractureState& s) {
                   "fracture state: node arrays of " << n << " nodes and " << s.conn.size() / k
                                                     << " elements do not fit the model (" << mesh.num_nodes()
                                                     << " nodes before fracture, " << ne << " elements)");
-  SHATTER_REQUIRE(s.facet_state.size() == static_cast<size_t>(topology_.num_facets()),
-                  "fracture state: " << s.facet_state.size() << " facets, the model has "
-                                     << topology_.num_facets());
+  // The named facets: interior facets of this topology, ascending, each once.
+  const std::vector<Index> open = facets(s.facet_gid);
+  SHATTER_REQUIRE(s.facet_state.size() == s.facet_gid.size() && open.size() == s.facet_gid.size() &&
+                      std::is_sorted(s.facet_gid.begin(), s.facet_gid.end()) &&
+                      std::adjacent_find(s.facet_gid.begin(), s.facet_gid.end()) == s.facet_gid.end(),
+                  "fracture state: " << s.facet_gid.size() << " facet ids, " << open.size()
+                                     << " of them interior facets of the model, ascending and distinct, and "
+                                     << s.facet_state.size() << " states");
   for (FacetState f : s.facet_state)
-    SHATTER_REQUIRE(f == FacetState::intact || f == FacetState::cohesive || f == FacetState::free,
-                    "fracture state: facet state " << int(f) << " is not one of intact, cohesive, free");
+    SHATTER_REQUIRE(f == FacetState::cohesive || f == FacetState::free,
+                    "fracture state: facet state " << int(f) << " is not one of cohesive, free");
   const CohesiveElements& c = s.cohesive;
-  const size_t nc = c.facet.size();
+  const size_t nc = s.cohesive_facet_gid.size();
+  const std::vector<Index> cohesive_facets = facets(s.cohesive_facet_gid);
+  SHATTER_REQUIRE(cohesive_facets.size() == nc, "fracture state: a cohesive facet id is no interior facet of the model");
   SHATTER_REQUIRE(c.side_local.size() == nc * kCohesiveSlots && c.side_nodes.size() == nc * kCohesiveSlots && c.area.size() == nc &&
                       c.normal.size() == nc && c.delta_max.size() == nc * kCohesivePoints,
                   "fracture state: the cohesive element arrays disagree in size");
   for (Index a : s.conn) SHATTER_REQUIRE(a >= 0 && static_cast<size_t>(a) < n, "fracture state: node " << a << " in conn is out of range");
-  for (Index f : c.facet)
-    SHATTER_REQUIRE(f >= 0 && f < topology_.num_facets() && s.facet_state[f] != FacetState::intact,
-                    "fracture state: cohesive facet " << f << " is out of range or intact");
+  for (GlobalId g : s.cohesive_facet_gid)
+    SHATTER_REQUIRE(std::binary_search(s.facet_gid.begin(), s.facet_gid.end(), g),
+                    "fracture state: cohesive facet " << g << " is intact");
   for (Index a : c.side_nodes)
     SHATTER_REQUIRE(a >= -1 && (a < 0 || static_cast<size_t>(a) < n), "fracture state: side node " << a << " is out of range");
   for (std::int8_t a : c.side_local)
@@ -238,9 +254,11 @@ void FractureStage::restore(const FractureState& s) {
   model_.bc_mask = s.bc_mask;
   model_.bc_velocity = s.bc_velocity;
   model_.initial_velocity = s.initial_velocity;
-  topology_.facet_state = s.facet_state;
+  for (Index f : by_gid_) topology_.facet_state[f] = FacetState::intact;
+  for (size_t i = 0; i < open.size(); ++i) topology_.facet_state[open[i]] = s.facet_state[i];
   ++facet_revision_;
   cohesive_ = s.cohesive;
+  cohesive_.facet = cohesive_facets;
   bound_key_ = {-1, -1, -1};  // the cohesive elements changed: compute the bound afresh
 }
 

@@ -30,8 +30,12 @@ inline constexpr int kCohesiveSlots = 2 * 6;
 ///   reference[n] (m), node_gid[n], node_body[n], conn[e k]: the mesh after splits
 ///   mass[n] (kg), bc_mask[n], bc_velocity[n] (m/s), initial_velocity[n] (m/s):
 ///                  the model's per-node arrays, grown with the mesh
-///   facet_state[f] Topology::facet_state
-///   cohesive       every cohesive element with its delta_max
+///   facet_gid[o], facet_state[o]: the interior facets that are not intact
+///                  (o of them: cohesive or freed), by Topology::facet_gid,
+///                  ascending, and their states: named as on any rank
+///   cohesive       every cohesive element with its delta_max; its facet ids
+///                  are not kept (local to a topology): cohesive_facet_gid[c]
+///                  names each one's facet
 struct FractureState {
   std::uint64_t mesh_revision = ~std::uint64_t{0};  ///< none copied yet
   std::vector<Vec3> reference;
@@ -41,8 +45,10 @@ struct FractureState {
   std::vector<double> mass;
   std::vector<std::uint8_t> bc_mask;
   std::vector<Vec3> bc_velocity, initial_velocity;
+  std::vector<GlobalId> facet_gid;
   std::vector<FacetState> facet_state;
   CohesiveElements cohesive;
+  std::vector<GlobalId> cohesive_facet_gid;
 };
 
 class FractureStage {
@@ -115,10 +121,10 @@ class FractureStage {
   std::vector<Index> debonded(std::span<const Vec3> x) const;
   /// Frees `facets` (every rank's debonded(), the same list everywhere); returns how many.
   Index release(std::span<const Index> facets);
-  /// The delta_max in `from` (a saved state, FractureState::cohesive) of the
-  /// cohesive elements owned here (rows: their indices, ascending;
-  /// kCohesivePoints values per row), for a checkpoint's gather.
-  std::vector<double> owned_delta_max(const CohesiveElements& from, std::vector<Index>& rows) const;
+  /// The delta_max in `from` (a saved state) of the cohesive elements owned
+  /// here (rows: their indices, ascending; kCohesivePoints values per row),
+  /// for a checkpoint's gather.
+  std::vector<double> owned_delta_max(const FractureState& from, std::vector<Index>& rows) const;
 
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);

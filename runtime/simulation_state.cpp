@@ -34,10 +34,11 @@ void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationSt
     if (fracture_) {
       // Each cohesive element's delta_max from its owner, which computes it.
       std::vector<Index> rows;
-      const std::vector<double> mine = fracture_->owned_delta_max(s.fracture->cohesive, rows);
+      const std::vector<double> mine = fracture_->owned_delta_max(*s.fracture, rows);
       std::vector<double> all;
       timed(comm_seconds_, [&] {
-        all = to_root(rows, mine, kCohesivePoints, s.fracture->cohesive.size(), dec_->comm());
+        all = to_root(rows, mine, kCohesivePoints, static_cast<Index>(s.fracture->cohesive_facet_gid.size()),
+                      dec_->comm());
       });
       if (dec_->rank() == 0) s.fracture->cohesive.delta_max = std::move(all);
     }
