@@ -126,17 +126,22 @@ inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
   }
 }
 
-/// Squared stable time step of N TET4 Neo-Hookean elements, s^2, after
-/// tet4_neo_hookean_lanes(L, mat): dt^2 = h^2 / c^2 with h = tet4_stable_length
-/// (half the smallest altitude, h^2 = (6V)^2 / (4 max (2 A_face)^2), no square
-/// root) and c = mat.wave_speed(J) from L.lnJ (no second log); J <= 0 or NaN
-/// uses the reference wave speed, as the runtime does. Take the minimum over a
-/// block and one square root: sqrt is monotone, so sqrt(min dt^2) = min sqrt(dt^2).
-/// Same value as h / wave_speed(J) up to rounding (a few ulp), ~2x cheaper
-/// than both calls (which cost as much as the force kernel itself).
-template <int N>
-inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+/// Squared stable time step of N TET4 or TET10 Neo-Hookean elements, s^2,
+/// after their lane kernel (Tet4Lanes or Tet10Lanes L: corners in L.x[0..11],
+/// L.J and L.lnJ): dt^2 = h^2 / c^2 with h = `altitude_fraction` x the
+/// smallest altitude of the corner tetrahedron (1/2: tet4_stable_length, 1/4:
+/// tet10_stable_length), h^2 = fraction^2 (6V)^2 / max (2 A_face)^2 (no square
+/// root), and c = mat.wave_speed(J) from L.lnJ (no second log); J <= 0 or
+/// NaN uses the reference wave speed, as the runtime does. Take the minimum
+/// over a block and one square root: sqrt is monotone, so sqrt(min dt^2) =
+/// min sqrt(dt^2). Same value as h / wave_speed(J) up to rounding (a few
+/// ulp), ~2x cheaper than both calls (which cost as much as the TET4 force
+/// kernel itself).
+template <class Lanes, int N>
+inline void stable_dt_squared_lanes(const Lanes& L, const NeoHookean& mat, double altitude_fraction,
+                                    double (&dt2)[N]) {
   const double ref_stiff = mat.lambda + 2.0 * mat.mu;
+  const double scale = (altitude_fraction * altitude_fraction) * mat.density;
   for (int l = 0; l < N; ++l) {
     double d[9];  // ab, ac, ad
     for (int k = 0; k < 3; ++k)
@@ -156,8 +161,14 @@ inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean
     const double twice_area_sq = std::max(std::max(a0, a1), std::max(a2, a3));
     const double stiff =
         L.J[l] > 0 ? std::max(ref_stiff - 2.0 * mat.lambda * L.lnJ[l], ref_stiff) : ref_stiff;
-    dt2[l] = (0.25 * mat.density) * (six_volume * six_volume) / (twice_area_sq * stiff);  // one division
+    dt2[l] = scale * (six_volume * six_volume) / (twice_area_sq * stiff);  // one division
   }
+}
+
+/// TET4: h = tet4_stable_length (half the smallest altitude).
+template <int N>
+inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+  stable_dt_squared_lanes(L, mat, 0.5, dt2);
 }
 
 template <class Material>
