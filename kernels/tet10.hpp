@@ -140,7 +140,6 @@ inline void tet10_reference_into_lanes(const Tet10Reference& ref, Tet10Lanes<N>&
 /// ((lambda ln J - mu) / J) cof(F), f += w P dN/dX^T.
 template <int N>
 inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
-  const double mu = mat.mu, lambda = mat.lambda;
   for (int a = 0; a < 30; ++a)
     for (int l = 0; l < N; ++l) L.f[a][l] = 0.0;
   for (int l = 0; l < N; ++l) L.energy[l] = 0.0, L.J[l] = HUGE_VAL, L.lnJ[l] = HUGE_VAL;
@@ -154,31 +153,17 @@ inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
           for (int a = 1; a < 10; ++a) sum += L.x[3 * a + i][l] * L.dNdX[q][3 * a + j][l];
           F[3 * j + i][l] = sum;
         }
-      C[0][l] = F[4][l] * F[8][l] - F[5][l] * F[7][l];
-      C[1][l] = F[5][l] * F[6][l] - F[3][l] * F[8][l];
-      C[2][l] = F[3][l] * F[7][l] - F[4][l] * F[6][l];
-      C[3][l] = F[7][l] * F[2][l] - F[8][l] * F[1][l];
-      C[4][l] = F[8][l] * F[0][l] - F[6][l] * F[2][l];
-      C[5][l] = F[6][l] * F[1][l] - F[7][l] * F[0][l];
-      C[6][l] = F[1][l] * F[5][l] - F[2][l] * F[4][l];
-      C[7][l] = F[2][l] * F[3][l] - F[0][l] * F[5][l];
-      C[8][l] = F[0][l] * F[4][l] - F[1][l] * F[3][l];
-      detF[l] = F[0][l] * C[0][l] + F[1][l] * C[1][l] + F[2][l] * C[2][l];
+      detF[l] = cofactor_lane(F, C, l);
     }
     for (int l = 0; l < N; ++l) lnJ[l] = std::log(detF[l]);  // scalar libm calls
     for (int l = 0; l < N; ++l) {
-      double I1 = 0.0;
-      for (int k = 0; k < 9; ++k) I1 += F[k][l] * F[k][l];
-      const double w = L.w[q][l];
-      const double a = w * mu, b = w * ((lambda * lnJ[l] - mu) / detF[l]);
       double P[9];  // w P, column-major
-      for (int k = 0; k < 9; ++k) P[k] = a * F[k][l] + b * C[k][l];
+      L.energy[l] += neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.w[q][l], mat, l, P);
       // f_{a,i} += sum_j w P(i, j) dN_a/dX_j
       for (int n = 0; n < 10; ++n)
         for (int i = 0; i < 3; ++i)
           L.f[3 * n + i][l] += P[i] * L.dNdX[q][3 * n][l] + P[3 + i] * L.dNdX[q][3 * n + 1][l] +
                                P[6 + i] * L.dNdX[q][3 * n + 2][l];
-      L.energy[l] += w * (0.5 * mu * (I1 - 3.0) - mu * lnJ[l] + 0.5 * lambda * lnJ[l] * lnJ[l]);
       const bool smaller = detF[l] < L.J[l];  // as std::min: a NaN point is skipped
       L.lnJ[l] = smaller ? lnJ[l] : L.lnJ[l];
       L.J[l] = smaller ? detF[l] : L.J[l];
