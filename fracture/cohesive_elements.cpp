@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -75,6 +76,46 @@ struct ShareView {
   bool counted(Index i) const { return share.counted.empty() || share.counted[i]; }
 };
 
+/// Adds the forces of the elements at positions [first, last) of `which`
+/// (local_force, 2k per element from `first`) to f_int. Every node receives
+/// them in the order of a serial loop over the elements (side 0 then side 1
+/// of each slot), so the bits are those of that loop for any thread count,
+/// and for any subset of the elements that holds a node's whole list. In
+/// parallel without coloring: the node ids are cut into as many ranges as
+/// threads, each holding about the same number of the block's slots
+/// (quantiles of a sample), and the task of a range walks the block in
+/// element order and adds only to its nodes. Each task reads every slot's
+/// node id (sequential) but writes only its own (the random accesses), so the
+/// writes divide among the threads.
+void scatter_block(const CohesiveElements& coh, const ShareView& which, int k, Index first, Index last,
+                   std::span<const Vec3> local_force, std::span<Vec3> f_int) {
+  auto nodes_of = [&](Index i) { return coh.side_nodes.data() + static_cast<size_t>(which[i]) * 2 * kSlots; };
+  auto add = [&](Index lo, Index hi) {
+    for (Index i = first; i < last; ++i) {
+      const Index* nodes = nodes_of(i);
+      const Vec3* f = local_force.data() + static_cast<size_t>(i - first) * 2 * k;
+      for (int j = 0; j < k; ++j) {
+        if (nodes[j] >= lo && nodes[j] < hi) f_int[nodes[j]] += f[j];
+        if (nodes[kSlots + j] >= lo && nodes[kSlots + j] < hi) f_int[nodes[kSlots + j]] += f[k + j];
+      }
+    }
+  };
+  const Index num_nodes = static_cast<Index>(f_int.size());
+  const int ranges = std::min<Index>(tbb::this_task_arena::max_concurrency(), (last - first) / 64);
+  if (ranges <= 1) return add(0, num_nodes);
+  constexpr int kSampleStride = 7;  // slots between samples (odd: both sides sampled)
+  std::vector<Index> sample;
+  size_t slot = 0;
+  for (Index i = first; i < last; ++i)
+    for (int t = 0; t < 2 * kSlots; ++t, ++slot)
+      if (slot % kSampleStride == 0 && nodes_of(i)[t] >= 0) sample.push_back(nodes_of(i)[t]);
+  std::sort(sample.begin(), sample.end());
+  std::vector<Index> cut(ranges + 1, num_nodes);
+  cut[0] = 0;
+  for (int r = 1; r < ranges; ++r) cut[r] = sample[sample.size() * r / ranges];
+  tbb::parallel_for(0, ranges, [&](int r) { add(cut[r], cut[r + 1]); });
+}
+
 }  // namespace
 
 Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& coh,
@@ -130,8 +171,8 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
   const ShareView which{share, coh.size()};
   const Index nc = which.count();
   // Blocks of elements: local forces computed in parallel into a buffer that
-  // stays in cache, then scattered serially in element order, so the sums
-  // do not depend on the threads.
+  // stays in cache, then scattered in parallel by node ranges, each node in
+  // element order (scatter_block), so the sums do not depend on the threads.
   constexpr Index kBlock = 4096;
   std::vector<Vec3> local_force(static_cast<size_t>(std::min(nc, kBlock)) * 2 * k);
   std::vector<std::array<double, 2>> local_energy(std::min(nc, kBlock));  // stored, dissipated
@@ -192,13 +233,8 @@ CohesiveEnergy cohesive_forces(const Mesh& mesh, const Topology& topo, CohesiveE
             }
           }
         });
+    scatter_block(coh, which, k, first, last, local_force, f_int);
     for (Index i = first; i < last; ++i) {
-      const Index* nodes = coh.side_nodes.data() + static_cast<size_t>(which[i]) * 2 * kSlots;
-      const Vec3* f = local_force.data() + static_cast<size_t>(i - first) * 2 * k;
-      for (int j = 0; j < k; ++j) {
-        f_int[nodes[j]] += f[j];
-        f_int[nodes[kSlots + j]] += f[k + j];
-      }
       if (!which.counted(i)) continue;
       total.stored += local_energy[i - first][0];
       total.dissipated += local_energy[i - first][1];

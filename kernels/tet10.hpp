@@ -8,6 +8,7 @@
 //   corner i: L_i (2 L_i - 1),   edge (i,j): 4 L_i L_j.
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 #include "kernels/neo_hookean.hpp"
 #include "kernels/tet4.hpp"
@@ -106,20 +107,102 @@ struct Tet10Force {
   double J;
 };
 
+/// N TET10 elements side by side in struct-of-arrays layout (lane l = one
+/// element), for tet10_neo_hookean_lanes. Units as in tet10_internal_force.
+template <int N>
+struct Tet10Lanes {
+  double x[30][N];        ///< in: node positions, x[3a + i][l] = x_{a,i}, m
+  double dNdX[4][30][N];  ///< in: per point q, dN_a/dX_j at dNdX[q][3a + j][l], 1/m
+  double w[4][N];         ///< in: per point, weight x det(dX/dxi), m^3
+  double f[30][N];        ///< out: internal nodal forces dE/dx, f[3a + i][l], N
+  double energy[N];       ///< out: strain energy, J
+  double J[N];            ///< out: smallest det F over the points
+  double lnJ[N];          ///< out: ln of that J (for the wave speed without a second log)
+};
+
+/// The lanes of element e's reference constants (dN/dX and weights) into lane l.
+template <int N>
+inline void tet10_reference_into_lanes(const Tet10Reference& ref, Tet10Lanes<N>& L, int l) {
+  for (int q = 0; q < 4; ++q) {
+    const double* d = ref.dNdX[q].data();  // column-major 10 x 3: dN_a/dX_j at a + 10 j
+    for (int a = 0; a < 10; ++a)
+      for (int j = 0; j < 3; ++j) L.dNdX[q][3 * a + j][l] = d[a + 10 * j];
+    L.w[q][l] = ref.wdetJ[q];
+  }
+}
+
+/// TET10 Neo-Hookean internal forces of N elements at once, the 4-point rule
+/// written lane-wise in scalar IEEE arithmetic with a fixed order of
+/// operations (as tet4_neo_hookean_lanes), so the compiler vectorises across
+/// elements and every lane is bitwise equal to the one-lane result
+/// (tet10_internal_force with NeoHookean is this function with N = 1). Per
+/// point: F = x dN/dX, cof(F) for det F and F^-T, one log, P = mu F +
+/// ((lambda ln J - mu) / J) cof(F), f += w P dN/dX^T.
+template <int N>
+inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
+  for (int a = 0; a < 30; ++a)
+    for (int l = 0; l < N; ++l) L.f[a][l] = 0.0;
+  for (int l = 0; l < N; ++l) L.energy[l] = 0.0, L.J[l] = HUGE_VAL, L.lnJ[l] = HUGE_VAL;
+  for (int q = 0; q < 4; ++q) {
+    double F[9][N], C[9][N], detF[N], lnJ[N];
+    for (int l = 0; l < N; ++l) {
+      // F(i, j) = sum_a x_{a,i} dN_a/dX_j, F[3j + i]
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+          double sum = L.x[i][l] * L.dNdX[q][j][l];
+          for (int a = 1; a < 10; ++a) sum += L.x[3 * a + i][l] * L.dNdX[q][3 * a + j][l];
+          F[3 * j + i][l] = sum;
+        }
+      detF[l] = cofactor_lane(F, C, l);
+    }
+    for (int l = 0; l < N; ++l) lnJ[l] = std::log(detF[l]);  // scalar libm calls
+    for (int l = 0; l < N; ++l) {
+      double P[9];  // w P, column-major
+      L.energy[l] += neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.w[q][l], mat, l, P);
+      // f_{a,i} += sum_j w P(i, j) dN_a/dX_j
+      for (int n = 0; n < 10; ++n)
+        for (int i = 0; i < 3; ++i)
+          L.f[3 * n + i][l] += P[i] * L.dNdX[q][3 * n][l] + P[3 + i] * L.dNdX[q][3 * n + 1][l] +
+                               P[6 + i] * L.dNdX[q][3 * n + 2][l];
+      const bool smaller = detF[l] < L.J[l];  // as std::min: a NaN point is skipped
+      L.lnJ[l] = smaller ? lnJ[l] : L.lnJ[l];
+      L.J[l] = smaller ? detF[l] : L.J[l];
+    }
+  }
+}
+
+/// Squared stable step of N TET10 elements after tet10_neo_hookean_lanes:
+/// h = tet10_stable_length (a quarter of the corner tetrahedron's smallest
+/// altitude), c = wave speed at the smallest det F (stable_dt_squared_lanes).
+template <int N>
+inline void tet10_stable_dt_squared_lanes(const Tet10Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+  stable_dt_squared_lanes(L, mat, 0.25, dt2);
+}
+
 template <class Material>
 inline Tet10Force tet10_internal_force(const Tet10Nodes& x, const Tet10Reference& ref, const Material& mat) {
   Tet10Force out;
-  out.f.setZero();
-  out.energy = 0.0;
-  out.J = HUGE_VAL;
-  for (int q = 0; q < 4; ++q) {
-    const Mat3 F = x * ref.dNdX[q];
-    Mat3 P;
-    double W;
-    mat.stress_energy(F, P, W);
-    out.f.noalias() += ref.wdetJ[q] * P * ref.dNdX[q].transpose();
-    out.energy += ref.wdetJ[q] * W;
-    out.J = std::min(out.J, F.determinant());
+  if constexpr (std::is_same_v<Material, NeoHookean>) {
+    Tet10Lanes<1> L;
+    for (int q = 0; q < 30; ++q) L.x[q][0] = x.data()[q];
+    tet10_reference_into_lanes(ref, L, 0);
+    tet10_neo_hookean_lanes(L, mat);
+    for (int q = 0; q < 30; ++q) out.f.data()[q] = L.f[q][0];
+    out.energy = L.energy[0];
+    out.J = L.J[0];
+  } else {
+    out.f.setZero();
+    out.energy = 0.0;
+    out.J = HUGE_VAL;
+    for (int q = 0; q < 4; ++q) {
+      const Mat3 F = x * ref.dNdX[q];
+      Mat3 P;
+      double W;
+      mat.stress_energy(F, P, W);
+      out.f.noalias() += ref.wdetJ[q] * P * ref.dNdX[q].transpose();
+      out.energy += ref.wdetJ[q] * W;
+      out.J = std::min(out.J, F.determinant());
+    }
   }
   return out;
 }

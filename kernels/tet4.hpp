@@ -73,6 +73,41 @@ struct Tet4Lanes {
   double lnJ[N];         ///< out: ln det F (for NeoHookean wave speed without a second log)
 };
 
+/// Lane l of the lane kernels: cof(F) = J F^-T into C and det F returned
+/// (F, C column-major, F[3j + i][l] = F(i, j)): column j of cof(F) is the
+/// cross product of the two other columns. The lane helpers are always
+/// inlined: a call inside the loop over the lanes stops its vectorisation
+/// (GCC 12 at -march=x86-64-v4: 2.6x slower).
+template <int N>
+[[gnu::always_inline]] inline double cofactor_lane(const double (&F)[9][N], double (&C)[9][N], int l) {
+  C[0][l] = F[4][l] * F[8][l] - F[5][l] * F[7][l];
+  C[1][l] = F[5][l] * F[6][l] - F[3][l] * F[8][l];
+  C[2][l] = F[3][l] * F[7][l] - F[4][l] * F[6][l];
+  C[3][l] = F[7][l] * F[2][l] - F[8][l] * F[1][l];
+  C[4][l] = F[8][l] * F[0][l] - F[6][l] * F[2][l];
+  C[5][l] = F[6][l] * F[1][l] - F[7][l] * F[0][l];
+  C[6][l] = F[1][l] * F[5][l] - F[2][l] * F[4][l];
+  C[7][l] = F[2][l] * F[3][l] - F[0][l] * F[5][l];
+  C[8][l] = F[0][l] * F[4][l] - F[1][l] * F[3][l];
+  return F[0][l] * C[0][l] + F[1][l] * C[1][l] + F[2][l] * C[2][l];
+}
+
+/// Lane l of the lane kernels: w P (column-major, into P) and the energy
+/// w W returned, for the volume (or quadrature weight) w, with
+/// w P = a F + b cof(F), a = w mu, b = w (lambda ln J - mu) / J, from
+/// P = mu F + ((lambda ln J - mu) / J) cof(F).
+template <int N>
+[[gnu::always_inline]] inline double neo_hookean_lane_stress(const double (&F)[9][N], const double (&C)[9][N],
+                                                             double detF, double lnJ, double w, const NeoHookean& mat,
+                                                             int l, double (&P)[9]) {
+  const double mu = mat.mu, lambda = mat.lambda;
+  double I1 = 0.0;
+  for (int q = 0; q < 9; ++q) I1 += F[q][l] * F[q][l];
+  const double a = w * mu, b = w * ((lambda * lnJ - mu) / detF);
+  for (int q = 0; q < 9; ++q) P[q] = a * F[q][l] + b * C[q][l];
+  return w * (0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lambda * lnJ * lnJ);
+}
+
 /// TET4 Neo-Hookean internal forces of N elements at once. Same formulas as
 /// tet4_internal_force written lane-wise, in scalar IEEE arithmetic with a fixed
 /// order of operations, so the compiler vectorises across elements (SSE2: 2
@@ -82,7 +117,6 @@ struct Tet4Lanes {
 /// determinant: cof(F) gives both det F and F^-T.
 template <int N>
 inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
-  const double mu = mat.mu, lambda = mat.lambda;
   double F[9][N], C[9][N], detF[N];
   double* lnJ = L.lnJ;
   for (int l = 0; l < N; ++l) {
@@ -94,49 +128,38 @@ inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
       for (int i = 0; i < 3; ++i)
         F[3 * j + i][l] = d[i] * L.Dm_inv[3 * j][l] + d[3 + i] * L.Dm_inv[3 * j + 1][l] +
                           d[6 + i] * L.Dm_inv[3 * j + 2][l];
-    // cof(F) = J F^-T: column j is the cross product of the two other columns
-    C[0][l] = F[4][l] * F[8][l] - F[5][l] * F[7][l];
-    C[1][l] = F[5][l] * F[6][l] - F[3][l] * F[8][l];
-    C[2][l] = F[3][l] * F[7][l] - F[4][l] * F[6][l];
-    C[3][l] = F[7][l] * F[2][l] - F[8][l] * F[1][l];
-    C[4][l] = F[8][l] * F[0][l] - F[6][l] * F[2][l];
-    C[5][l] = F[6][l] * F[1][l] - F[7][l] * F[0][l];
-    C[6][l] = F[1][l] * F[5][l] - F[2][l] * F[4][l];
-    C[7][l] = F[2][l] * F[3][l] - F[0][l] * F[5][l];
-    C[8][l] = F[0][l] * F[4][l] - F[1][l] * F[3][l];
-    detF[l] = F[0][l] * C[0][l] + F[1][l] * C[1][l] + F[2][l] * C[2][l];
+    detF[l] = cofactor_lane(F, C, l);
   }
   for (int l = 0; l < N; ++l) lnJ[l] = std::log(detF[l]);  // scalar libm calls
   for (int l = 0; l < N; ++l) {
-    double I1 = 0.0;
-    for (int q = 0; q < 9; ++q) I1 += F[q][l] * F[q][l];
-    // V0 P = a F + b cof(F), from P = mu F + ((lambda ln J - mu) / J) cof(F)
-    const double V0 = L.V0[l];
-    const double a = V0 * mu, b = V0 * ((lambda * lnJ[l] - mu) / detF[l]);
     double P[9];
-    for (int q = 0; q < 9; ++q) P[q] = a * F[q][l] + b * C[q][l];
+    L.energy[l] = neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.V0[l], mat, l, P);
     // forces on nodes 1..3: H = V0 P Dm^-T, H(i, j) = sum_k V0 P(i, k) Dm^-1(j, k)
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i)
         L.f[3 * (j + 1) + i][l] =
             P[i] * L.Dm_inv[j][l] + P[3 + i] * L.Dm_inv[3 + j][l] + P[6 + i] * L.Dm_inv[6 + j][l];
     for (int i = 0; i < 3; ++i) L.f[i][l] = -(L.f[3 + i][l] + L.f[6 + i][l] + L.f[9 + i][l]);
-    L.energy[l] = V0 * (0.5 * mu * (I1 - 3.0) - mu * lnJ[l] + 0.5 * lambda * lnJ[l] * lnJ[l]);
     L.J[l] = detF[l];
   }
 }
 
-/// Squared stable time step of N TET4 Neo-Hookean elements, s^2, after
-/// tet4_neo_hookean_lanes(L, mat): dt^2 = h^2 / c^2 with h = tet4_stable_length
-/// (half the smallest altitude, h^2 = (6V)^2 / (4 max (2 A_face)^2), no square
-/// root) and c = mat.wave_speed(J) from L.lnJ (no second log); J <= 0 or NaN
-/// uses the reference wave speed, as the runtime does. Take the minimum over a
-/// block and one square root: sqrt is monotone, so sqrt(min dt^2) = min sqrt(dt^2).
-/// Same value as h / wave_speed(J) up to rounding (a few ulp), ~2x cheaper
-/// than both calls (which cost as much as the force kernel itself).
-template <int N>
-inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+/// Squared stable time step of N TET4 or TET10 Neo-Hookean elements, s^2,
+/// after their lane kernel (Tet4Lanes or Tet10Lanes L: corners in L.x[0..11],
+/// L.J and L.lnJ): dt^2 = h^2 / c^2 with h = `altitude_fraction` x the
+/// smallest altitude of the corner tetrahedron (1/2: tet4_stable_length, 1/4:
+/// tet10_stable_length), h^2 = fraction^2 (6V)^2 / max (2 A_face)^2 (no square
+/// root), and c = mat.wave_speed(J) from L.lnJ (no second log); J <= 0 or
+/// NaN uses the reference wave speed, as the runtime does. Take the minimum
+/// over a block and one square root: sqrt is monotone, so sqrt(min dt^2) =
+/// min sqrt(dt^2). Same value as h / wave_speed(J) up to rounding (a few
+/// ulp), ~2x cheaper than both calls (which cost as much as the TET4 force
+/// kernel itself).
+template <class Lanes, int N>
+inline void stable_dt_squared_lanes(const Lanes& L, const NeoHookean& mat, double altitude_fraction,
+                                    double (&dt2)[N]) {
   const double ref_stiff = mat.lambda + 2.0 * mat.mu;
+  const double scale = (altitude_fraction * altitude_fraction) * mat.density;
   for (int l = 0; l < N; ++l) {
     double d[9];  // ab, ac, ad
     for (int k = 0; k < 3; ++k)
@@ -156,8 +179,14 @@ inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean
     const double twice_area_sq = std::max(std::max(a0, a1), std::max(a2, a3));
     const double stiff =
         L.J[l] > 0 ? std::max(ref_stiff - 2.0 * mat.lambda * L.lnJ[l], ref_stiff) : ref_stiff;
-    dt2[l] = (0.25 * mat.density) * (six_volume * six_volume) / (twice_area_sq * stiff);  // one division
+    dt2[l] = scale * (six_volume * six_volume) / (twice_area_sq * stiff);  // one division
   }
+}
+
+/// TET4: h = tet4_stable_length (half the smallest altitude).
+template <int N>
+inline void tet4_stable_dt_squared_lanes(const Tet4Lanes<N>& L, const NeoHookean& mat, double (&dt2)[N]) {
+  stable_dt_squared_lanes(L, mat, 0.5, dt2);
 }
 
 template <class Material>

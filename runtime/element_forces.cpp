@@ -12,6 +12,12 @@
 
 namespace shatter {
 namespace {
+// Elements per lane group (TET4 and TET10): 8 doubles fill an AVX-512
+// vector, two AVX2 or four SSE ones; 8 lanes measured faster than 4 at every
+// width (more independent work per instruction, docs/performance.md "Whole step").
+constexpr int kLanes = 8;
+static_assert(ElementForces::kGranule % kLanes == 0);
+
 // a is a worse volume ratio than b: NaN beats everything, then the smaller.
 bool worse(double a, double b) { return std::isnan(a) ? !std::isnan(b) : a < b; }
 
@@ -30,17 +36,19 @@ void tet4_lanes(const Model& model, std::span<const Vec3> x, const Index* es, co
   tet4_neo_hookean_lanes(L, m);
 }
 
-// TET10 element e at positions x: its forces, and its stable step h / c(J) in `dt`.
-Tet10Force tet10_element(const Model& model, std::span<const Vec3> x, Index e, double& dt) {
-  const NeoHookean& m = model.materials[model.mesh.elem_material[e]];
-  const Index* c = model.mesh.conn.data() + 10 * static_cast<size_t>(e);
-  Tet10Nodes xe;
-  for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
-  const Tet10Force out = tet10_internal_force(xe, model.tet10_ref[e], m);
-  const double h = tet10_stable_length(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
-  // J <= 0 (or NaN) would make the wave speed NaN; the caller diagnoses it.
-  dt = h / m.wave_speed(out.J > 0 ? out.J : 1.0);
-  return out;
+// The N TET10 elements es[0..N) at positions x into the lanes, forces, det F
+// and the squared stable step computed.
+template <int N>
+void tet10_lanes(const Model& model, std::span<const Vec3> x, const Index* es, const NeoHookean& m,
+                 Tet10Lanes<N>& L, double (&dt2)[N]) {
+  for (int l = 0; l < N; ++l) {
+    const Index* c = model.mesh.conn.data() + 10 * static_cast<size_t>(es[l]);
+    for (int a = 0; a < 10; ++a)
+      for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = x[c[a]][i];
+    tet10_reference_into_lanes(model.tet10_ref[es[l]], L, l);
+  }
+  tet10_neo_hookean_lanes(L, m);
+  tet10_stable_dt_squared_lanes(L, m, dt2);
 }
 }  // namespace
 
@@ -54,7 +62,11 @@ ElementStep element_stable_step(const Model& model, std::span<const Vec3> x, Ind
     r.dt = std::sqrt(dt2[0]);
     r.J = L.J[0];
   } else {
-    r.J = tet10_element(model, x, e, r.dt).J;
+    Tet10Lanes<1> L;
+    double dt2[1];
+    tet10_lanes<1>(model, x, &e, model.materials[model.mesh.elem_material[e]], L, dt2);
+    r.dt = std::sqrt(dt2[0]);
+    r.J = L.J[0];
   }
   return r;
 }
@@ -183,9 +195,9 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     for (size_t i = r.begin(); i < r.end(); ++i) f_int[restricted ? zero_nodes_[i] : i].setZero();
   });
 
-  // TET4: four consecutive elements of one material go through the lane
-  // kernel together (vectorised across elements); the rest one at a time
-  // through the same code with one lane, so the forces are the same bits.
+  // kLanes consecutive elements of one material go through the lane kernel
+  // together (vectorised across elements); the rest one at a time through
+  // the same code with one lane, so the forces are the same bits.
   auto tet4_group = [&]<int N>(const Index* es, const NeoHookean& m, double& energy, double& dt2, double& minJ,
                                Index& worst) {
     Tet4Lanes<N> L;
@@ -204,10 +216,27 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     }
   };
 
+  auto tet10_group = [&]<int N>(const Index* es, const NeoHookean& m, double& energy, double& dt2, double& minJ,
+                                Index& worst) {
+    Tet10Lanes<N> L;
+    double lane_dt2[N];
+    tet10_lanes<N>(model_, x, es, m, L, lane_dt2);
+    for (int l = 0; l < N; ++l) {
+      const Index* c = conn + 10 * static_cast<size_t>(es[l]);
+      for (int a = 0; a < 10; ++a) f_int[c[a]] += Vec3(L.f[3 * a][l], L.f[3 * a + 1][l], L.f[3 * a + 2][l]);
+      energy += L.energy[l];
+      dt2 = std::min(dt2, lane_dt2[l]);
+      if (worse(L.J[l], minJ)) {
+        minJ = L.J[l];
+        worst = es[l];
+      }
+    }
+  };
+
   auto run_block = [&](Index b) {
     const Index* first = subset_.data() + subset_offsets_[b];
     const Index* last = subset_.data() + subset_offsets_[b + 1];
-    double dt = HUGE_VAL, dt2 = HUGE_VAL, minJ = HUGE_VAL;
+    double dt2 = HUGE_VAL, minJ = HUGE_VAL;
     Index worst = -1;
     // One granule at a time: its energy is summed on its own.
     for (const Index* g0 = first; g0 < last;) {
@@ -215,36 +244,24 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
       const Index* g1 = g0;
       while (g1 < last && model_.whole_element(*g1) / kGranule == granule) ++g1;
       double energy = 0;
-      if (mesh.order == 1) {
-        for (const Index* e = g0; e < g1;) {
-          const int m = mat[*e];
-          if (g1 - e >= 4 && mat[e[1]] == m && mat[e[2]] == m && mat[e[3]] == m) {
-            tet4_group.template operator()<4>(e, mats[m], energy, dt2, minJ, worst);
-            e += 4;
-          } else {
-            tet4_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
-            e += 1;
-          }
-        }
-      } else {
-        for (const Index* p = g0; p < g1; ++p) {
-          const Index e = *p;
-          const Index* c = conn + 10 * static_cast<size_t>(e);
-          double element_dt = 0;
-          const Tet10Force out = tet10_element(model_, x, e, element_dt);
-          for (int a = 0; a < 10; ++a) f_int[c[a]] += out.f.col(a);
-          energy += out.energy;
-          dt = std::min(dt, element_dt);
-          if (worse(out.J, minJ)) {
-            minJ = out.J;
-            worst = e;
-          }
-        }
+      for (const Index* e = g0; e < g1;) {
+        const int m = mat[*e];
+        const bool group =
+            g1 - e >= kLanes && std::all_of(e + 1, e + kLanes, [&](Index o) { return mat[o] == m; });
+        if (mesh.order == 1 && group)
+          tet4_group.template operator()<kLanes>(e, mats[m], energy, dt2, minJ, worst);
+        else if (mesh.order == 1)
+          tet4_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
+        else if (group)
+          tet10_group.template operator()<kLanes>(e, mats[m], energy, dt2, minJ, worst);
+        else
+          tet10_group.template operator()<1>(e, mats[m], energy, dt2, minJ, worst);
+        e += group ? kLanes : 1;
       }
       granule_energy_[std::lower_bound(granules_.begin(), granules_.end(), granule) - granules_.begin()] = energy;
       g0 = g1;
     }
-    if (mesh.order == 1) dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt
+    const double dt = std::sqrt(dt2);  // sqrt is monotone: sqrt(min dt^2) = min dt
     if (!stress6.empty())
       for (const Index* e = first; e < last; ++e)
         element_cauchy_stress6(model_, x, *e, stress6.data() + 6 * static_cast<size_t>(*e));
