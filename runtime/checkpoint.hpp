@@ -51,7 +51,7 @@
 //       attributes nodes (n), facets (f), cohesive_elements (c), mesh_revision;
 //       datasets, each with fnv1a64 like /state's:
 //       reference n x 3, node_gid n (int64), node_body n (int32),
-//       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3,
+//       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3, bc_condition n x 3 (int32),
 //       initial_velocity n x 3, facet_state f (uint8: 0 intact, 1 cohesive,
 //       2 free), cohesive_facet c (int32), cohesive_side_local c x 12 (int8),
 //       cohesive_side_nodes c x 12 (int32), cohesive_area c, cohesive_normal

@@ -26,7 +26,7 @@ inline constexpr int kCohesiveSlots = 2 * 6;
 /// f = facets of the Topology):
 ///   mesh_revision  Mesh::revision these arrays are of
 ///   reference[n] (m), node_gid[n], node_body[n], conn[e k]: the mesh after splits
-///   mass[n] (kg), bc_mask[n], bc_velocity[n] (m/s), initial_velocity[n] (m/s):
+///   mass[n] (kg), bc_mask[n], bc_velocity[n], bc_condition[n], initial_velocity[n] (m/s):
 ///                  the model's per-node arrays, grown with the mesh
 ///   facet_state[f] Topology::facet_state
 ///   cohesive       every cohesive element with its delta_max
@@ -39,6 +39,7 @@ struct FractureState {
   std::vector<double> mass;
   std::vector<std::uint8_t> bc_mask;
   std::vector<Vec3> bc_velocity, initial_velocity;
+  std::vector<std::array<std::int32_t, 3>> bc_condition;
   std::vector<FacetState> facet_state;
   CohesiveElements cohesive;
 };

@@ -13,6 +13,7 @@
 #include "runtime/diagnosis.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/loads.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
 #include "runtime/timed.hpp"
@@ -56,6 +57,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   }
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
+  if (!model_.load_faces.empty()) loads_ = std::make_unique<SurfaceLoads>(model_);
   if (model_.scene.fracture_enabled()) {
     fracture_ = std::make_unique<FractureStage>(model_);
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
@@ -140,6 +142,14 @@ void Simulation::compute_forces(long step, double time, const std::function<void
     f_ext_[i] = model_.mass[i] * g;
     a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
   });
+  if (loads_) {
+    loads_->compute(x_, time);
+    for (size_t k = 0; k < loads_->nodes().size(); ++k) {
+      const Index i = loads_->nodes()[k];
+      f_ext_[i] += loads_->force()[k];
+      a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
+    }
+  }
   // Prescribed components: no acceleration; the reaction is the force that holds them.
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
     const Index i = bc_nodes_[b];
@@ -165,6 +175,14 @@ void Simulation::step() {
   book_gravity_work();
   compute_forces(step_ + 1, time_ + dt_, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
   if (contact_) book_contact_work();
+  if (loads_) {
+    // The loads' work by the trapezoidal rule, W += (F(n) + F(n+1))/2 . (x(n+1) - x(n)).
+    for (size_t k = 0; k < loads_->nodes().size(); ++k) {
+      const Index i = loads_->nodes()[k];
+      if (dec_->owns_node(i))
+        step_work_[kLoadWork] += 0.5 * (load_force_old_[k] + loads_->force()[k]).dot(x_[i] - load_x_old_[k]);
+    }
+  }
   correct(reaction_old);
   time_ += dt_;
   ++step_;
@@ -173,21 +191,40 @@ void Simulation::step() {
   check_ledger();
 }
 
-void Simulation::half_kick() {
-  const double half = 0.5 * dt_;
+void Simulation::half_kick(bool predicting) {
+  const double half = 0.5 * dt_, end = time_ + dt_;
+  const std::vector<BoundaryConditionSpec>& conditions = model_.scene.boundary_conditions;
+  bc_factor_.resize(conditions.size());
+  for (size_t k = 0; k < conditions.size(); ++k) {
+    const Amplitude& a = conditions[k].amplitude;
+    bc_factor_[k] = conditions[k].displacement ? (predicting ? a.value(end) : a.rate(end))
+                                               : a.value(predicting ? time_ + half : end);
+  }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) {
     v_[i] += half * a_[i];
     if (model_.bc_mask[i])
       for (int c = 0; c < 3; ++c)
-        if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
+        if (model_.bc_mask[i] & (1u << c)) {
+          const int k = model_.bc_condition[i][c];
+          const double value = model_.bc_velocity[i][c] * bc_factor_[k];
+          // A displacement is reached at the end of the step from x(n).
+          v_[i][c] = predicting && conditions[k].displacement
+                         ? (model_.mesh.reference[i][c] + value - x_[i][c]) / dt_
+                         : value;
+        }
   });
 }
 
 void Simulation::predict() {
-  half_kick();
+  half_kick(true);
   bc_dx_.resize(bc_nodes_.size());
   for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
   if (contact_) x_prev_ = x_;
+  if (loads_) {
+    load_x_old_.resize(loads_->nodes().size());
+    for (size_t k = 0; k < load_x_old_.size(); ++k) load_x_old_[k] = x_[loads_->nodes()[k]];
+    load_force_old_ = loads_->force();
+  }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) { x_[i] += dt_ * v_[i]; });
 }
 
@@ -243,7 +280,7 @@ void Simulation::book_contact_work() {
 }
 
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
-  half_kick();
+  half_kick(false);
   // The reactions' work by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
   for (size_t b = 0; b < bc_nodes_.size(); ++b)
     if (dec_->owns_node(bc_nodes_[b]))
@@ -286,6 +323,7 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   const Index n = model_.mesh.num_nodes();
   for (auto* a : {&x_, &v_, &a_, &f_int_, &f_ext_, &model_.bc_velocity, &model_.initial_velocity}) a->resize(n);
   model_.bc_mask.resize(n);
+  model_.bc_condition.resize(n);
   model_.mass.resize(n);
   inv_mass_.resize(n);
   if (contact_) contact_inv_mass_.resize(n);
@@ -295,6 +333,7 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
     v_[child] = v_[parent];
     model_.bc_mask[child] = model_.bc_mask[parent];
     model_.bc_velocity[child] = model_.bc_velocity[parent];
+    model_.bc_condition[child] = model_.bc_condition[parent];
     model_.initial_velocity[child] = model_.initial_velocity[parent];
     if (model_.bc_mask[child]) {
       bc_nodes_.push_back(child);
@@ -310,6 +349,7 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
     inv_mass_[i] = 1.0 / model_.mass[i];
     if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
+  if (loads_) loads_->rebuild();
   dec_->rebuild_nodes();
 }
 
@@ -348,7 +388,8 @@ void Simulation::update_ledger() {
   ledger_.momentum = Vec3(t[kP].value(), t[kP + 1].value(), t[kP + 2].value());
   ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());
   ledger_.strain = t[kStrain].value();
-  ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value();
+  ledger_.external_work +=
+      t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value() + t[kLocal + kLoadWork].value();
   ledger_.contact_work += t[kLocal + kContactWork].value();
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +

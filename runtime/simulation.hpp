@@ -37,6 +37,7 @@ class FieldWriter;
 class FailureChannel;
 class CsvWriter;
 class ContactStage;
+class SurfaceLoads;
 class Decomposition;
 struct SharedNodes;
 struct DecompositionStats;
@@ -125,8 +126,11 @@ class Simulation {
 
  private:
   // The stages of step(), in order.
-  /// v(n+1/2) = v(n) + dt/2 a(n) on the touched nodes (prescribed components set).
-  void half_kick();
+  /// v += dt/2 a on the touched nodes, prescribed components set: at the
+  /// mid step (`predicting`: a velocity times its amplitude there, or the
+  /// velocity that reaches a displacement times its amplitude at the end of
+  /// the step) or at the end (a velocity, or a displacement's rate, there).
+  void half_kick(bool predicting);
   /// half_kick, then x(n+1) = x(n) + dt v(n+1/2); keeps x(n) for contact and
   /// the prescribed nodes' displacements for the reactions' work.
   void predict();
@@ -181,7 +185,7 @@ class Simulation {
   /// The step's work terms, exact sums over this rank's owned nodes, summed
   /// over the ranks by update_ledger: gravity's work, the reactions' work and
   /// the contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work).
-  enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
+  enum StepWork { kGravityWork, kReactionWork, kContactWork, kLoadWork, kStepWorks };
 
   Model& model_;
   RunOptions opt_;
@@ -198,6 +202,9 @@ class Simulation {
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
   std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
   std::vector<Vec3> bc_dx_;            ///< per bc node: its displacement over the step under way, m
+  std::vector<double> bc_factor_;      ///< per boundary condition: its values' factor at the half step under way
+  std::unique_ptr<SurfaceLoads> loads_;  ///< null without loads
+  std::vector<Vec3> load_x_old_, load_force_old_;  ///< per loaded node: x(n) and its load at x(n), for the work
   double time_ = 0, dt_ = 0, stable_dt_ = 0;
   StepControl step_control_;
   long step_ = 0;

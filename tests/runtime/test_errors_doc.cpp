@@ -99,6 +99,11 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
                                        << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
                                           "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
   std::ofstream(dir / "garbage.msh") << "this is not a mesh\n";
+  // A good tetrahedron with named physical groups: a point, a surface, the volume.
+  std::ofstream(dir / "tet.msh") << header
+                                 << "$PhysicalNames\n3\n0 1 \"corner\"\n2 2 \"bottom\"\n3 3 \"solid\"\n$EndPhysicalNames\n"
+                                    "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+                                    "$Elements\n3\n1 15 2 1 1 1\n2 2 2 2 2 1 3 2\n3 4 2 3 3 1 2 3 4\n$EndElements\n";
   std::ofstream(dir / "v40.msh") << "$MeshFormat\n4 0 8\n$EndMeshFormat\n";
   std::ofstream(dir / "cut.msh") << header << "$Elements\n2\n1 4 2 1 1 1 2 3 4\n";
   std::ofstream(dir / "unknown_type.msh") << header << "$Elements\n1\n3 777 0 1 2 3\n$EndElements\n";
