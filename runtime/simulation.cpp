@@ -238,13 +238,14 @@ void Simulation::resolve_contact() {
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
   for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
-  const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt_);
+  const DcrResult r = contact_->apply(x_prev_, x_, v_, inv_mass_, dt_, model_.bc_mask);
   for (size_t k = 0; k < vertices.size(); ++k) {
     contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
     contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
   }
   ledger_.contacts = r.contacts;
   ledger_.contact_dissipated += r.dissipated;
+  ledger_.external_work += r.support_work;
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
       throw Error(sweep_cap_diagnosis(model_, x_, contact_->candidates(), r, step_ + 1, time_ + dt_));
@@ -326,7 +327,6 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   model_.bc_condition.resize(n);
   model_.mass.resize(n);
   inv_mass_.resize(n);
-  if (contact_) contact_inv_mass_.resize(n);
   std::vector<Index> touched;
   for (const auto& [child, parent] : new_nodes) {
     x_[child] = x_[parent];
@@ -345,10 +345,7 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   recompute_node_masses(model_, touched);
-  for (Index i : touched) {
-    inv_mass_[i] = 1.0 / model_.mass[i];
-    if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
-  }
+  for (Index i : touched) inv_mass_[i] = 1.0 / model_.mass[i];
   if (loads_) loads_->rebuild();
   dec_->rebuild_nodes();
 }
@@ -360,11 +357,6 @@ void Simulation::node_arrays_from_model() {
   for (Index i = 0; i < n; ++i) {
     inv_mass_[i] = 1.0 / model_.mass[i];
     if (model_.bc_mask[i]) bc_nodes_.push_back(i);
-  }
-  // DCR treats a node with any prescribed component as immovable.
-  if (contact_) {
-    contact_inv_mass_.resize(n);
-    for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
 }
 

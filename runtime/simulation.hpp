@@ -215,7 +215,6 @@ class Simulation {
   double total0_ = 0, energy_scale_ = 0;
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
-  std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
   std::vector<Vec3> contact_dx_,
       contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block

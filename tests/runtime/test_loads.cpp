@@ -206,3 +206,41 @@ TEST(Loads, HistoryLedgerClosesUnderAPressurePulse) {
   EXPECT_LT(drift, 1e-3 * largest) << "drift " << drift << " J of " << largest << " J";
 }
 
+// DCR and a held component (contact/dcr.hpp, DcrOptions::held): a block
+// thrown obliquely, with friction, at a plate whose top face is held along z
+// (a symmetry plane). The plate's top nodes never move along z, yet take the
+// friction's tangential impulses: momentum along x and y, which no condition
+// holds, is conserved to round-off, and the plate is dragged along. (When a
+// held node was immovable in every component, the plate took no x momentum.)
+TEST(Constraints, ContactMovesAHeldNodeInItsFreeComponentsOnly) {
+  Model m = build_model(scene_from_text(
+      "held_contact",
+      "name: held_contact\ntime: {end: 3.0e-3}\nmaterials:\n"
+      "  soft: {model: neo_hookean, density: 1000, youngs_modulus: 1.0e7, poisson_ratio: 0.3}\n"
+      "bodies:\n"
+      "  - {name: plate, material: soft, mesh: {shape: box, size: [0.08, 0.08, 0.01], center: [0, 0, -0.005], "
+      "element_size: 0.01}}\n"
+      "  - {name: block, material: soft, mesh: {shape: box, size: [0.02, 0.02, 0.02], center: [0, 0, 0.0105], "
+      "element_size: 0.01}, initial_velocity: [3, 2, -2]}\n"
+      "boundary_conditions:\n  - {body: plate, region: {face: zmax}, velocity: [null, null, 0]}\n"
+      "contact: {friction: 0.3, restitution: 1.0}\n"));
+  Simulation sim(m, {});
+  const Vec3 p0 = sim.ledger().momentum;
+  long contacts = 0;
+  while (sim.time() < m.scene.end_time) {
+    sim.step();
+    contacts += sim.ledger().contacts;
+  }
+  ASSERT_GT(contacts, 0);
+  const Vec3 p = sim.ledger().momentum;
+  EXPECT_LT(std::abs(p.x() - p0.x()), 1e-12 * p0.norm());
+  EXPECT_LT(std::abs(p.y() - p0.y()), 1e-12 * p0.norm());
+  Vec3 plate = Vec3::Zero();
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
+    if (m.mesh.node_body[i] == 0) plate += m.mass[i] * sim.velocities()[i];
+  EXPECT_GT(plate.x(), 1e-3 * p0.x()) << "the plate took no friction impulse";
+  for (Index i : condition_nodes(m, 0)) {
+    EXPECT_EQ(sim.positions()[i].z(), m.mesh.reference[i].z());
+    EXPECT_EQ(sim.velocities()[i].z(), 0.0);
+  }
+}
