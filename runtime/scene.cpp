@@ -365,6 +365,26 @@ int read_body_name(const Reader& r, const YAML::Node& c, const std::string& key,
   r.fail(key + ".body", "the name of a body", c["body"]);
 }
 
+/// What a condition or a load (`key`, a mapping with `keys`) acts on: its body and region.
+template <class Spec>
+Spec read_acting_on(const Reader& r, const YAML::Node& c, const std::string& key, const Scene& s,
+                    std::initializer_list<const char*> keys) {
+  r.only_keys(c, key, keys);
+  Spec spec;
+  spec.key = key;
+  spec.body = read_body_name(r, c, key, s);
+  spec.region = read_region(r, r.required(c, key, "region"), key + ".region", s.bodies[spec.body]);
+  return spec;
+}
+
+/// Whether `c` gives key a (else b): exactly one of them, `expected` describing both.
+bool read_either(const Reader& r, const YAML::Node& c, const std::string& key, const char* a, const char* b,
+                 const std::string& expected) {
+  if (c[a] && c[b]) r.fail(key, std::string("expected one of ") + a + " or " + b + ", not both");
+  if (!c[a] && !c[b]) r.fail(key, "expected one of " + expected + " (a required key)");
+  return static_cast<bool>(c[a]);
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
@@ -476,7 +496,8 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::string key = "bodies[" + std::to_string(i) + "]";
     const YAML::Node b = bodies[i];
-    r.only_keys(b, key, {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient"});
+    r.only_keys(b, key,
+                {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient", "rigid"});
     BodySpec body;
     body.key = key;
     body.name = b["name"] ? r.string(b["name"], key + ".name") : "body" + std::to_string(i);
@@ -509,26 +530,41 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     if (b["initial_velocity"]) body.initial_velocity = r.vec3(b["initial_velocity"], key + ".initial_velocity");
     if (b["angular_velocity"]) body.angular_velocity = r.vec3(b["angular_velocity"], key + ".angular_velocity");
     if (b["velocity_gradient"]) body.velocity_gradient = r.mat3(b["velocity_gradient"], key + ".velocity_gradient");
+    if (const YAML::Node rigid = b["rigid"]) {
+      if (!rigid.IsScalar() || (rigid.Scalar() != "true" && rigid.Scalar() != "false"))
+        r.fail(key + ".rigid", "true or false", rigid);
+      body.rigid = rigid.Scalar() == "true";
+      if (body.rigid && (body.angular_velocity != Vec3::Zero() || body.velocity_gradient))
+        r.fail(key + ".rigid",
+               "false with angular_velocity or velocity_gradient (a rigid body translates; rotation is not built yet)",
+               rigid);
+    }
     s.bodies.push_back(body);
   }
   for (const auto& b : s.bodies)
     if (b.mesh_file.empty() && b.shape.order != s.bodies[0].shape.order)
       r.fail(b.key + ".mesh.order", "the same element order for every body");
 
+  // A rigid body: its initial velocity prescribed on every node, before any condition.
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (!s.bodies[i].rigid) continue;
+    BoundaryConditionSpec bc;
+    bc.key = s.bodies[i].key + ".rigid";
+    bc.body = static_cast<int>(i);
+    bc.region.lo = Vec3::Constant(-HUGE_VAL);
+    bc.region.hi = Vec3::Constant(HUGE_VAL);
+    for (int k = 0; k < 3; ++k) bc.value[k] = s.bodies[i].initial_velocity[k];
+    s.boundary_conditions.push_back(bc);
+  }
   if (const YAML::Node bcs = root["boundary_conditions"]) {
     if (!bcs.IsSequence()) r.fail("boundary_conditions", "a list of boundary conditions", bcs);
     for (std::size_t i = 0; i < bcs.size(); ++i) {
       const std::string key = "boundary_conditions[" + std::to_string(i) + "]";
       const YAML::Node c = bcs[i];
-      r.only_keys(c, key, {"body", "region", "velocity", "displacement", "amplitude"});
-      BoundaryConditionSpec bc;
-      bc.key = key;
-      bc.body = read_body_name(r, c, key, s);
-      bc.region = read_region(r, r.required(c, key, "region"), key + ".region", s.bodies[bc.body]);
-      if (c["velocity"] && c["displacement"]) r.fail(key, "expected one of velocity or displacement, not both");
-      if (!c["velocity"] && !c["displacement"])
-        r.fail(key, "expected one of velocity [vx, vy, vz] or displacement [ux, uy, uz] (a required key)");
-      bc.displacement = static_cast<bool>(c["displacement"]);
+      BoundaryConditionSpec bc = read_acting_on<BoundaryConditionSpec>(
+          r, c, key, s, {"body", "region", "velocity", "displacement", "amplitude"});
+      bc.displacement = !read_either(r, c, key, "velocity", "displacement",
+                                     "velocity [vx, vy, vz] or displacement [ux, uy, uz]");
       const std::string vk = key + "." + bc.quantity();
       const YAML::Node v = c[bc.quantity()];
       if (!v.IsSequence() || v.size() != 3)
@@ -551,15 +587,12 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     for (std::size_t i = 0; i < loads.size(); ++i) {
       const std::string key = "loads[" + std::to_string(i) + "]";
       const YAML::Node c = loads[i];
-      r.only_keys(c, key, {"body", "region", "pressure", "traction", "amplitude"});
-      LoadSpec load;
-      load.key = key;
-      load.body = read_body_name(r, c, key, s);
-      load.region = read_region(r, r.required(c, key, "region"), key + ".region", s.bodies[load.body]);
-      if (c["pressure"] && c["traction"]) r.fail(key, "expected one of pressure or traction, not both");
-      if (c["pressure"]) load.pressure = r.number(c["pressure"], key + ".pressure");
-      else if (c["traction"]) load.traction = r.vec3(c["traction"], key + ".traction");
-      else r.fail(key, "expected one of pressure (Pa) or traction ([tx, ty, tz], Pa) (a required key)");
+      LoadSpec load =
+          read_acting_on<LoadSpec>(r, c, key, s, {"body", "region", "pressure", "traction", "amplitude"});
+      if (read_either(r, c, key, "pressure", "traction", "pressure (Pa) or traction ([tx, ty, tz], Pa)"))
+        load.pressure = r.number(c["pressure"], key + ".pressure");
+      else
+        load.traction = r.vec3(c["traction"], key + ".traction");
       if (c["amplitude"]) load.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
       s.loads.push_back(load);
     }

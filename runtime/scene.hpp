@@ -42,6 +42,10 @@ struct BodySpec {
   Vec3 initial_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Mat3> velocity_gradient;
+  /// bodies[i].rigid: the body moves with its initial velocity for ever (a condition
+  /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions):
+  /// infinite mass in DCR, its contact impulses' work in external_work.
+  bool rigid = false;
   std::string key;             ///< "bodies[i]", for messages
 };
 

@@ -22,33 +22,26 @@ Amplitude make(Amplitude::Form form, double t0, double t1) {
 }  // namespace
 
 TEST(Amplitude, FormsTakeTheirDefiningValues) {
-  EXPECT_EQ(Amplitude{}.value(3.0), 1.0);
-  EXPECT_EQ(Amplitude{}.rate(3.0), 0.0);
   Amplitude table;
   table.form = Amplitude::Form::table;
   table.table = {{1.0, 0.0}, {2.0, 4.0}, {4.0, -2.0}};
-  EXPECT_EQ(table.value(0.0), 0.0);   // held before the first point
-  EXPECT_EQ(table.value(1.5), 2.0);
-  EXPECT_EQ(table.value(3.0), 1.0);
-  EXPECT_EQ(table.value(9.0), -2.0);  // held after the last
-  EXPECT_EQ(table.rate(1.5), 4.0);
-  EXPECT_EQ(table.rate(3.0), -3.0);
-  EXPECT_EQ(table.rate(9.0), 0.0);
-  const Amplitude ramp = make(Amplitude::Form::ramp, 0, 2.0);
-  EXPECT_EQ(ramp.value(0.0), 0.0);
-  EXPECT_EQ(ramp.value(1.0), 0.5);
-  EXPECT_EQ(ramp.value(5.0), 1.0);
-  const Amplitude smooth = make(Amplitude::Form::smooth_step, 1.0, 3.0);
-  EXPECT_EQ(smooth.value(0.5), 0.0);
-  EXPECT_DOUBLE_EQ(smooth.value(2.0), 0.5);
-  EXPECT_EQ(smooth.value(3.5), 1.0);
-  EXPECT_EQ(smooth.rate(1.0), 0.0);
-  EXPECT_EQ(smooth.rate(3.0), 0.0);
-  const Amplitude sine = make(Amplitude::Form::half_sine, 1.0, 3.0);
-  EXPECT_EQ(sine.value(0.5), 0.0);
-  EXPECT_DOUBLE_EQ(sine.value(2.0), 1.0);
-  EXPECT_NEAR(sine.value(3.0), 0.0, 1e-15);
-  EXPECT_EQ(sine.value(3.5), 0.0);
+  const Amplitude constant, ramp = make(Amplitude::Form::ramp, 0, 2.0), smooth = make(Amplitude::Form::smooth_step, 1.0, 3.0),
+                  sine = make(Amplitude::Form::half_sine, 1.0, 3.0);
+  // {amplitude, t, value(t), rate(t)}: tables held before the first point and after the
+  // last; the smooth step's middle and its flat ends; the half sine's peak and ends.
+  const struct {
+    const Amplitude& a;
+    double t, value, rate;
+  } cases[] = {{constant, 3.0, 1.0, 0.0}, {table, 0.0, 0.0, 0.0},  {table, 1.5, 2.0, 4.0},
+               {table, 3.0, 1.0, -3.0},     {table, 9.0, -2.0, 0.0}, {ramp, 0.0, 0.0, 0.5},
+               {ramp, 1.0, 0.5, 0.5},       {ramp, 5.0, 1.0, 0.0},   {smooth, 0.5, 0.0, 0.0},
+               {smooth, 1.0, 0.0, 0.0},     {smooth, 2.0, 0.5, 0.9375}, {smooth, 3.0, 1.0, 0.0},
+               {smooth, 3.5, 1.0, 0.0},     {sine, 0.5, 0.0, 0.0},   {sine, 2.0, 1.0, 0.0},
+               {sine, 3.0, 0.0, -std::numbers::pi / 2}, {sine, 3.5, 0.0, 0.0}};
+  for (const auto& c : cases) {
+    EXPECT_NEAR(c.a.value(c.t), c.value, 1e-15) << "form " << int(c.a.form) << ", t = " << c.t;
+    EXPECT_NEAR(c.a.rate(c.t), c.rate, 1e-15) << "form " << int(c.a.form) << ", t = " << c.t;
+  }
 }
 
 TEST(Amplitude, RatesMatchCentralDifferences) {

@@ -5,6 +5,7 @@
 // the exact list of bad-input messages, and stays so.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -177,7 +178,8 @@ TEST(ErrorsDoc, EveryMessageIsTheBinarys) {
   const Page page = read_page(fs::path(SHATTER_SOURCE_DIR) / "docs" / "errors.md");
   ASSERT_FALSE(page.base_scene.empty()) << "docs/errors.md has no ```yaml base scene";
   ASSERT_GT(page.rows.size(), 30u);
-  const fs::path dir = fs::temp_directory_path() / "shatter_errors_doc";
+  // One folder per process: the suites of other builds on the machine run this test too.
+  const fs::path dir = fs::temp_directory_path() / ("shatter_errors_doc_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "scene.yaml") << page.base_scene;
@@ -192,4 +194,5 @@ TEST(ErrorsDoc, EveryMessageIsTheBinarys) {
     EXPECT_EQ(status, row.status) << row.what << ": " << row.command;
     EXPECT_EQ(line, expand(row.message)) << row.what << ": " << row.command;
   }
+  fs::remove_all(dir);
 }
