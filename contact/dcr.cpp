@@ -61,13 +61,15 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass, double dt,
                            const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           const DcrGather& gather) {
+                           const DcrGather& gather, std::span<const std::uint8_t> held_masks) {
   const size_t n_nodes = x_new.size();
   SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
                   "resolve_contacts: nodal arrays differ in size (x_new "
                       << n_nodes << ", x_old " << x_old.size() << ", v " << v.size() << ", inv_mass " << inv_mass.size()
                       << ")");
   SHATTER_REQUIRE(dt > 0, "resolve_contacts: step length dt = " << dt << " s");
+  SHATTER_REQUIRE(held_masks.empty() || held_masks.size() == n_nodes,
+                  "resolve_contacts: " << held_masks.size() << " held masks for " << n_nodes << " nodes");
   SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
   for (const Index i : mine) {
     SHATTER_REQUIRE(i >= 0 && static_cast<size_t>(i) < pairs.size(),
@@ -85,7 +87,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
 
   DcrResult result;
   std::vector<Index> resolved;  // every pair resolved, with repeats
-  std::vector<double> dissipated;
+  std::vector<double> dissipated, support_work;
   std::vector<std::uint8_t> active;
   // The first round's box test keeps the pairs of mine that may touch; later rounds check
   // only those, and only when a node moved in the previous round.
@@ -132,6 +134,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
     // Resolution: one Gauss-Seidel pass over the found pairs, color by color.
     const Coloring colors = color_found(pairs, found, scratch.slot);
     dissipated.assign(found.size(), 0.0);
+    support_work.assign(found.size(), 0.0);
     active.assign(found.size(), 0);
     for (int c = 0; c < colors.num_colors(); ++c) {
       const std::span<const Index> group = colors.items_of(c);
@@ -139,17 +142,35 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
         for (size_t k = r.begin(); k != r.end(); ++k) {
           const Index f = group[k];
           const ContactPair& p = pairs[found[f]];
-          PairPoints X_old, X_new, V;
+          PairPoints X_old, X_new, V, W;
           PairWeights w;
+          bool held = false, driven = false;  // a held component; one held at a non-zero velocity
           for (int i = 0; i < 4; ++i) {
             const Index n = p.nodes[i];
             X_old.col(i) = x_old[n];
             X_new.col(i) = x_new[n];
             V.col(i) = v[n];
             w[i] = inv_mass[n];
+            const std::uint8_t h = held_masks.empty() ? 0 : held_masks[n];
+            for (int c = 0; c < 3; ++c) {
+              const bool hc = (h >> c) & 1u;
+              W(c, i) = hc ? 0.0 : w[i];
+              held = held || hc;
+              driven = driven || (hc && V(c, i) != 0.0);
+            }
           }
-          const DcrPairResponse out =
-              dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, pair_normals(p, surface, tn), w, law, 0.5 * dt);
+          const PairPoints V_before = V;
+          const PairNormals N = pair_normals(p, surface, tn);
+          const DcrPairResponse out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, W, law, 0.5 * dt)
+                                           : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, w, law, 0.5 * dt);
+          if (driven && out.active) {
+            // The free components' kinetic energy change beyond the dissipation came from the supports.
+            double gained = 0;
+            for (int i = 0; i < 4; ++i)
+              for (int c = 0; c < 3; ++c)
+                if (W(c, i) > 0) gained += 0.5 / W(c, i) * (V(c, i) * V(c, i) - V_before(c, i) * V_before(c, i));
+            support_work[f] = gained + out.impulse.dissipated;
+          }
           if (!out.active) continue;
           active[f] = 1;
           dissipated[f] = out.impulse.dissipated;
@@ -166,6 +187,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
       if (active[f]) {
         resolved.push_back(found[f]);
         result.dissipated += dissipated[f];
+        result.support_work += support_work[f];
       }
     if (result.sweeps == options.max_sweeps) {
       result.capped = true;

@@ -32,6 +32,10 @@ struct DcrResult {
   Index contacts = 0;       ///< distinct pairs resolved in the step (history "contacts")
   int sweeps = 0;           ///< rounds run, the last one (which found nothing, unless capped) included
   double dissipated = 0.0;  ///< kinetic energy lost by the impacts and friction, J
+  /// The work of the conditions that hold components moving at a non-zero velocity on the
+  /// pairs, through the impulses (the kinetic energy the free components gained beyond the
+  /// dissipation), J; 0 when every held component is at rest (summed in pair order).
+  double support_work = 0.0;
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
   Index unresolved = -1;    ///< when capped: the first pair (index into the pairs) found in the last round
   Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds
@@ -69,7 +73,10 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 ///   v         velocities (m/s), changed in place by the impulses;
 ///   inv_mass  inverse lumped masses (1/kg), 0 for a fixed node (never moved);
 ///   dt        the step length (s): x_new = x_old + dt v before contact;
-///   surface   the outward normals at x_old that orient the pairs (DcrSurface).
+///   surface   the outward normals at x_old that orient the pairs (DcrSurface);
+///   held      per node (empty: none), bit k set = component k held by a boundary condition:
+///             such a node moves only in its free components (its mass counts as infinite
+///             in the held ones: weighted() in kernels/dcr.hpp); held in all three, never.
 /// pairs is the candidate list (the same on every rank) and mine the indices of the pairs
 /// this rank checks, ascending. The work goes in rounds:
 ///   1. detection, in parallel, reading only: in the first round each pair of mine whose swept
@@ -90,6 +97,6 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass,
                            double dt, const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           const DcrGather& gather = {});
+                           const DcrGather& gather = {}, std::span<const std::uint8_t> held = {});
 
 }  // namespace shatter

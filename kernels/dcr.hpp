@@ -50,6 +50,21 @@ using PairNormals = Eigen::Matrix<double, 3, 2>;
 /// One value per node of a pair, e.g. the inverse lumped masses (1/kg; 0 = fixed node).
 using PairWeights = Eigen::Vector4d;
 
+/// W G for the inverse masses W of a pair's nodes: one per node (PairWeights), or one per
+/// node and component (PairPoints: 0 in a component a condition holds, so that the
+/// decompositions move the node only in its free components, as if its mass were infinite
+/// in the held ones). Both give the same bits for the same per-node values.
+template <class Derived>
+PairPoints weighted(const PairPoints& G, const Eigen::MatrixBase<Derived>& w) {
+  if constexpr (Derived::RowsAtCompileTime == 3) {
+    return G.cwiseProduct(w.derived());
+  } else {
+    PairPoints D = G;
+    for (int i = 0; i < 4; ++i) D.col(i) *= w[i];
+    return D;
+  }
+}
+
 enum class DcrPairKind : std::uint8_t { VertexFace = 0, EdgeEdge = 1 };
 
 /// Where in the step dcr_resolve_pair places a collision (scene key contact.placement).
@@ -344,14 +359,14 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// does not move) and nodes with W_i = 0 stay put. When the cubic has no root in reach,
 /// the step goes to its maximum and the gradient is re-evaluated at X (at most 4 passes).
 /// Returns whether g(X) > 0 afterwards (false e.g. when all four nodes are fixed).
-inline bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
-                        const PairWeights& inv_mass, double gap) {
+template <class Weights>
+bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
+                 const Weights& inv_mass, double gap) {
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
     const PairPoints G = s * pair_volume_gradient(pass == 0 ? X_contact : X);
-    PairPoints D = G;
-    for (int i = 0; i < 4; ++i) D.col(i) *= inv_mass[i];
+    const PairPoints D = weighted(G, inv_mass);
     DcrCubic g = pair_volume_along(X, D);
     g = {s * g.c0 - target, s * g.c1, s * g.c2, s * g.c3};
     if (g.c0 >= 0.0) return true;
@@ -383,7 +398,7 @@ struct DcrImpulse {
 
 /// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
 /// "Solving the collision equations"), V (columns, m/s) updated in place.
-/// Normal: with G = grad g(X), W = M^-1 (inv_mass, 0 = fixed node),
+/// Normal: with G = grad g(X), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
 ///   v_n = G . V / (G . W G)  [kg m/s];  if v_n < 0 (approaching):
 ///   V' = V - (1 + e) v_n W G,  dissipated = (1 - e^2) v_n^2 (G . W G) / 2.
 /// Friction: the contact point splits as sum_i c_i x_i (vertex minus the barycentric point
@@ -396,12 +411,12 @@ struct DcrImpulse {
 ///   v_s = F . V / (F . W F);  needed impulse v_s, limit mu J_n / |sum_A F_i|
 /// (J_n = normal impulse on side A = the vertex / edge a); stick when within the limit,
 /// else slide with the limit: V' = V - j W F, dissipated j (F . W F) (v_s - j / 2).
-inline DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X, PairPoints& V,
-                              const PairWeights& inv_mass, const DcrLaw& law) {
+template <class Weights>
+DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X, PairPoints& V,
+                       const Weights& inv_mass, const DcrLaw& law) {
   DcrImpulse out;
   const PairPoints G = orientation * pair_volume_gradient(X);
-  PairPoints D = G;
-  for (int i = 0; i < 4; ++i) D.col(i) *= inv_mass[i];
+  const PairPoints D = weighted(G, inv_mass);
   const double q = (G.array() * D.array()).sum();
   if (!(q > 0.0)) return out;
   const double v_n = (G.array() * V.array()).sum() / q;
@@ -453,8 +468,7 @@ inline DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPo
   const Vec3 r = X * c, t = X * d;
   PairPoints F = t * c.transpose() + r * d.transpose();  // grad of phi = r . t
   F -= ((F.array() * D.array()).sum() / q) * G;
-  PairPoints DF = F;
-  for (int i = 0; i < 4; ++i) DF.col(i) *= inv_mass[i];
+  const PairPoints DF = weighted(F, inv_mass);
   const double qf = (F.array() * DF.array()).sum();
   if (!(qf > 0.0)) return out;
   const double v_s = (F.array() * V.array()).sum() / qf;
@@ -498,10 +512,10 @@ struct DcrPairResponse {
 /// velocities) is the exception that moves angular momentum and energy: it is needed when the
 /// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
 /// strongly curved g(t)). X_new and V are updated in place.
-inline DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old,
-                                        PairPoints& X_new, PairPoints& V, const PairNormals& N,
-                                        const PairWeights& inv_mass, const DcrLaw& law,
-                                        double half_dt) {
+template <class Weights>
+DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new, PairPoints& V,
+                                 const PairNormals& N, const Weights& inv_mass, const DcrLaw& law,
+                                 double half_dt) {
   DcrPairResponse out;
   const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N);
   if (!pen.penetrating) return out;

@@ -220,4 +220,35 @@ Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int 
   return mesh;
 }
 
+std::vector<PhysicalGroup> model_physical_groups() {
+  std::vector<PhysicalGroup> out;
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups);
+  for (const auto& [dim, tag] : groups) {
+    PhysicalGroup g;
+    g.dim = dim;
+    gmsh::model::getPhysicalName(dim, tag, g.name);
+    if (g.name.empty()) continue;
+    std::vector<std::size_t> nodes;
+    std::vector<double> coords;
+    gmsh::model::mesh::getNodesForPhysicalGroup(dim, tag, nodes, coords);
+    g.nodes.assign(nodes.begin(), nodes.end());
+    if (dim == 2) {
+      std::vector<int> entities;
+      gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
+      for (int entity : entities)
+        for (const int type : {2, 9}) {  // 3- and 6-node triangles: corners first
+          std::vector<std::size_t> elements, element_nodes;
+          gmsh::model::mesh::getElementsByType(type, elements, element_nodes, entity);
+          const std::size_t k = type == 2 ? 3 : 6;
+          for (std::size_t t = 0; t + k <= element_nodes.size(); t += k)
+            g.triangles.push_back({static_cast<GlobalId>(element_nodes[t]), static_cast<GlobalId>(element_nodes[t + 1]),
+                                   static_cast<GlobalId>(element_nodes[t + 2])});
+        }
+    }
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
 }  // namespace shatter

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "mesh/mesh.hpp"
+#include "mesh/mesh_file.hpp"
 
 namespace shatter {
 
@@ -50,5 +51,9 @@ void require_tetrahedra_only(const std::vector<int>& volumes, const std::string&
 /// whose nodes are renumbered densely in order of first use; ids are Gmsh's
 /// tags. InputError when there are none.
 Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int material, const std::string& where);
+
+/// The named physical groups of the model, of every dimension (unnamed ones
+/// are left out: a scene names its regions).
+std::vector<PhysicalGroup> model_physical_groups();
 
 }  // namespace shatter

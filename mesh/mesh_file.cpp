@@ -76,7 +76,7 @@ namespace {
 /// file. Gmsh 4.8's readers crash on some malformed files (.unv, .vtk, and
 /// binary .msh: tests/fuzz/crashes/); in the child a crash is a refusal.
 Mesh read_through_child(const std::string& path, const char* format, const std::string& physical, int body,
-                        int material, const std::string& where) {
+                        int material, const std::string& where, std::vector<PhysicalGroup>* groups) {
   GmshSession session;
   static std::atomic<unsigned> serial{0};
   const TemporaryFile copy{std::filesystem::temp_directory_path() /
@@ -84,25 +84,28 @@ Mesh read_through_child(const std::string& path, const char* format, const std::
   convert_to_msh_in_child(path, format, copy.path.string(), where);
   const int order = tetrahedron_order(scan_msh_elements(copy.path.string(), where, path), path, where);
   open_in_gmsh(copy.path.string(), "a .msh", where, path);
-  return tetrahedra_of_model(order, path, physical, body, material, where);
+  Mesh mesh = tetrahedra_of_model(order, path, physical, body, material, where);
+  if (groups) *groups = model_physical_groups();
+  return mesh;
 }
 
 }  // namespace
 
-Mesh read_msh(const std::string& path, const std::string& physical, int body, int material, const std::string& where) {
+Mesh read_msh(const std::string& path, const std::string& physical, int body, int material, const std::string& where,
+              std::vector<PhysicalGroup>* groups) {
   require_file(path, where);
   // Which tetrahedra the file holds, from our own scan first: Gmsh 4.8 lists
   // a volume's tets by the type of its first one, overrunning its buffers
   // when the volume holds two orders (docs/errors.md), so such a file is
   // refused with that reason before Gmsh reads it.
   tetrahedron_order(scan_msh_elements(path, where), path, where);
-  return read_through_child(path, "a .msh", physical, body, material, where);
+  return read_through_child(path, "a .msh", physical, body, material, where, groups);
 }
 
 Mesh read_mesh_file(const std::string& path, const std::string& physical, int body, int material,
-                    const std::string& where) {
+                    const std::string& where, std::vector<PhysicalGroup>* groups) {
   const std::string ext = lower_extension(path);
-  if (ext == ".msh") return read_msh(path, physical, body, material, where);
+  if (ext == ".msh") return read_msh(path, physical, body, material, where, groups);
   const auto& formats = mesh_file_formats();
   const auto format =
       std::find_if(formats.begin(), formats.end(), [&](const MeshFileFormat& f) { return ext == f.extension; });
@@ -113,7 +116,7 @@ Mesh read_mesh_file(const std::string& path, const std::string& physical, int bo
                      "'); expected one of " + list + " (docs/scenes.md, \"Mesh files\")");
   }
   require_file(path, where);
-  return read_through_child(path, format->name, physical, body, material, where);
+  return read_through_child(path, format->name, physical, body, material, where, groups);
 }
 
 }  // namespace shatter

@@ -102,6 +102,10 @@ struct FileType<std::uint8_t> {
   static hid_t memory() { return H5T_NATIVE_UINT8; }
 };
 template <>
+struct FileType<std::array<std::int32_t, 3>> : FileType<std::int32_t> {
+  static constexpr hsize_t numbers = 3;
+};
+template <>
 struct FileType<FacetState> : FileType<std::uint8_t> {};
 static_assert(sizeof(FacetState) == 1);
 
@@ -285,8 +289,8 @@ std::uintmax_t checkpoint_bytes(const SimulationState& s) {
     const FractureState& f = *s.fracture;
     const CohesiveElements& c = f.cohesive;
     bytes += bytes_of(f.reference, f.node_gid, f.node_body, f.conn, f.mass, f.bc_mask, f.bc_velocity,
-                      f.initial_velocity, f.facet_gid, f.facet_state, f.cohesive_facet_gid, c.side_local, c.side_nodes,
-                      c.area, c.normal,
+                      f.bc_condition, f.initial_velocity, f.facet_gid, f.facet_state, f.cohesive_facet_gid,
+                      c.side_local, c.side_nodes, c.area, c.normal,
                       c.delta_max);
   }
   return bytes;
@@ -403,6 +407,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
       w.array(fr, "mass", f.mass);
       w.array(fr, "bc_mask", f.bc_mask);
       w.rows(fr, "bc_velocity", f.bc_velocity);
+      w.array(fr, "bc_condition", f.bc_condition, 3);
       w.rows(fr, "initial_velocity", f.initial_velocity);
       w.array(fr, "facet_gid", f.facet_gid);
       w.array(fr, "facet_state", f.facet_state);
@@ -523,6 +528,7 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
     f.mass = r.array<double>(fr, "mass", n);
     f.bc_mask = r.array<std::uint8_t>(fr, "bc_mask", n);
     f.bc_velocity = r.rows(fr, "bc_velocity", n);
+    f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3);
     f.initial_velocity = r.rows(fr, "initial_velocity", n);
     f.facet_gid = r.array<GlobalId>(fr, "facet_gid", static_cast<std::size_t>(facets));
     f.facet_state = r.array<FacetState>(fr, "facet_state", static_cast<std::size_t>(facets));

@@ -53,7 +53,7 @@
 //       intact), cohesive_elements (c), mesh_revision;
 //       datasets, each with fnv1a64 like /state's:
 //       reference n x 3, node_gid n (int64), node_body n (int32),
-//       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3,
+//       conn e x k (int32), mass n, bc_mask n (uint8), bc_velocity n x 3, bc_condition n x 3 (int32),
 //       initial_velocity n x 3, facet_gid f (int64: Topology::facet_gid,
 //       ascending), facet_state f (uint8: 1 cohesive, 2 free),
 //       cohesive_facet c (int64: facet gid), cohesive_side_local c x 12 (int8),

@@ -161,7 +161,7 @@ ContactPairs ContactStage::active_pairs() const {
 }
 
 DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                              std::span<const double> inv_mass, double dt) {
+                              std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held) {
   using clock = std::chrono::steady_clock;
   // Each phase's wall time, less the exchanges within it (counted apart).
   auto lap = [this, last = clock::now(), exchanged = profile_.exchange_seconds](double& seconds) mutable {
@@ -184,7 +184,7 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
       profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
     };
   const DcrResult r = resolve_contacts(pairs_, mine_, x_new, x_old, v, inv_mass, dt, options_,
-                                       {&surface_, &vertex_triangles_}, scratch_, gather);
+                                       {&surface_, &vertex_triangles_}, scratch_, gather, held);
   lap(profile_.sweep_seconds);
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());

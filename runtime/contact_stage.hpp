@@ -62,9 +62,10 @@ class ContactStage {
 
   /// Find the pairs penetrating during the motion x_old -> x_new and resolve
   /// them: x_new is projected back, v (the mid-step velocity) gets the DCR
-  /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move.
+  /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move;
+  /// held (empty: none): per node, bit k = component k held (resolve_contacts).
   DcrResult apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                  std::span<const double> inv_mass, double dt);
+                  std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {});
 
   /// Rebuild the surface after fracture split nodes: crack faces whose sides
   /// no longer share nodes join it, and older triangles get the new node ids.

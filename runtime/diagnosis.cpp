@@ -1,5 +1,6 @@
 #include "runtime/diagnosis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -40,23 +41,24 @@ std::string step_collapse_diagnosis(const Model& model, const StepCollapse& c, l
   // the element's nodes (by reference position, as build_model applies them).
   const int body = mesh.elem_body[c.element];
   std::vector<std::string> driving;
-  for (const BoundaryConditionSpec& bc : model.scene.boundary_conditions) {
+  for (size_t j = 0; j < model.scene.boundary_conditions.size(); ++j) {
+    const BoundaryConditionSpec& bc = model.scene.boundary_conditions[j];
     if (bc.body != body) continue;
     bool moves = false, holds = false;
-    for (int k = 0; k < 3; ++k) moves = moves || (bc.velocity[k] && *bc.velocity[k] != 0);
+    for (int k = 0; k < 3; ++k) moves = moves || (bc.value[k] && *bc.value[k] != 0);
     for (int a = 0; a < mesh.nodes_per_element(); ++a) {
-      const Vec3& X = mesh.reference[mesh.element(c.element)[a]];
-      holds = holds || ((X.array() >= bc.box_lo.array()).all() && (X.array() <= bc.box_hi.array()).all());
+      const auto& by = model.bc_condition[mesh.element(c.element)[a]];
+      holds = holds || std::find(by.begin(), by.end(), static_cast<std::int32_t>(j)) != by.end();
     }
     if (!moves && !holds) continue;
     std::ostringstream v;
-    v << bc.key << ".velocity = [";
+    v << bc.key << "." << bc.quantity() << " = [";
     for (int k = 0; k < 3; ++k) {
       v << (k ? ", " : "");
-      if (bc.velocity[k]) v << *bc.velocity[k];
+      if (bc.value[k]) v << *bc.value[k];
       else v << "null";
     }
-    v << "] m/s" << (holds ? " on its nodes" : "");
+    v << "] " << bc.unit() << (holds ? " on its nodes" : "");
     driving.push_back(v.str());
   }
   std::ostringstream shape;

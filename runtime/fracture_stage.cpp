@@ -192,6 +192,7 @@ void FractureStage::save(FractureState& s) const {
     s.mass = model_.mass;
     s.bc_mask = model_.bc_mask;
     s.bc_velocity = model_.bc_velocity;
+    s.bc_condition = model_.bc_condition;
     s.initial_velocity = model_.initial_velocity;
   }
   s.facet_gid.clear();
@@ -210,7 +211,7 @@ void FractureStage::restore(const FractureState& s) {
   Mesh& mesh = model_.mesh;
   const size_t n = s.reference.size(), ne = mesh.num_elements(), k = mesh.nodes_per_element();
   SHATTER_REQUIRE(n >= static_cast<size_t>(mesh.num_nodes()) && s.node_gid.size() == n && s.node_body.size() == n &&
-                      s.mass.size() == n && s.bc_mask.size() == n && s.bc_velocity.size() == n &&
+                      s.mass.size() == n && s.bc_mask.size() == n && s.bc_velocity.size() == n && s.bc_condition.size() == n &&
                       s.initial_velocity.size() == n && s.conn.size() == ne * k,
                   "fracture state: node arrays of " << n << " nodes and " << s.conn.size() / k
                                                     << " elements do not fit the model (" << mesh.num_nodes()
@@ -253,6 +254,7 @@ void FractureStage::restore(const FractureState& s) {
   model_.mass = s.mass;
   model_.bc_mask = s.bc_mask;
   model_.bc_velocity = s.bc_velocity;
+  model_.bc_condition = s.bc_condition;
   model_.initial_velocity = s.initial_velocity;
   for (Index f : by_gid_) topology_.facet_state[f] = FacetState::intact;
   for (size_t i = 0; i < open.size(); ++i) topology_.facet_state[open[i]] = s.facet_state[i];

@@ -28,7 +28,7 @@ inline constexpr int kCohesiveSlots = 2 * 6;
 /// f = facets of the Topology):
 ///   mesh_revision  Mesh::revision these arrays are of
 ///   reference[n] (m), node_gid[n], node_body[n], conn[e k]: the mesh after splits
-///   mass[n] (kg), bc_mask[n], bc_velocity[n] (m/s), initial_velocity[n] (m/s):
+///   mass[n] (kg), bc_mask[n], bc_velocity[n], bc_condition[n], initial_velocity[n] (m/s):
 ///                  the model's per-node arrays, grown with the mesh
 ///   facet_gid[o], facet_state[o]: the interior facets that are not intact
 ///                  (o of them: cohesive or freed), by Topology::facet_gid,
@@ -45,6 +45,7 @@ struct FractureState {
   std::vector<double> mass;
   std::vector<std::uint8_t> bc_mask;
   std::vector<Vec3> bc_velocity, initial_velocity;
+  std::vector<std::array<std::int32_t, 3>> bc_condition;
   std::vector<GlobalId> facet_gid;
   std::vector<FacetState> facet_state;
   CohesiveElements cohesive;

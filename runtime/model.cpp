@@ -39,18 +39,26 @@ void check_estimate(const Scene& scene, double max_elements) {
 }
 
 /// Every body meshed (or read) and checked, appended in order, the elements
-/// along a space-filling curve.
-Mesh mesh_bodies(const Scene& scene, double max_elements) {
+/// along a space-filling curve; `groups` receives each body's physical groups
+/// (mesh files), their node ids shifted as append_mesh shifts the body's.
+Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vector<PhysicalGroup>>& groups) {
   check_estimate(scene, max_elements);
   Mesh mesh;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
     const std::string where = scene.file + ": " + body.key + ".mesh" +
                               (body.mesh_file.empty() ? "" : " (" + body.mesh_file + ")");
-    Mesh part = body.mesh_file.empty()
-                    ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
-                    : read_mesh_file(body.mesh_file, body.mesh_physical, static_cast<int>(b), body.material, where);
+    std::vector<PhysicalGroup>& body_groups = groups.emplace_back();
+    Mesh part = body.mesh_file.empty() ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
+                                       : read_mesh_file(body.mesh_file, body.mesh_physical, static_cast<int>(b),
+                                                        body.material, where, &body_groups);
     validate_mesh(part, where);
+    const GlobalId shift = mesh.node_gid.empty() ? 0 : *std::max_element(mesh.node_gid.begin(), mesh.node_gid.end());
+    for (PhysicalGroup& g : body_groups) {
+      for (GlobalId& id : g.nodes) id += shift;
+      for (auto& t : g.triangles)
+        for (GlobalId& id : t) id += shift;
+    }
     if (mesh.num_elements() > 0 && part.order != mesh.order)
       throw InputError(where + ": element order " + std::to_string(part.order) +
                        " differs from the first body's; expected one order for all bodies");
@@ -88,8 +96,36 @@ void on_root(MPI_Comm comm, F f) {
   }
 }
 
-/// The constants, masses, initial and boundary conditions of the model on `mesh`.
-void complete_model(Model& m);
+/// The nodes of each boundary condition and the faces of each load (scene order).
+struct RegionSelection {
+  std::vector<std::vector<Index>> condition_nodes;
+  std::vector<std::vector<BoundaryFace>> load_faces;
+};
+
+RegionSelection select_regions(const Scene& scene, const Mesh& mesh,
+                               const std::vector<std::vector<PhysicalGroup>>& groups) {
+  RegionSelection s;
+  auto context = [&](int body, const std::string& key) {
+    const BodySpec& b = scene.bodies[body];
+    return RegionContext{mesh, body, b.mesh_file.empty() ? &b.shape : nullptr,
+                         b.mesh_file.empty() ? nullptr : &groups[body], scene.file + ": " + key + ".region", b.name};
+  };
+  for (const BoundaryConditionSpec& bc : scene.boundary_conditions)
+    s.condition_nodes.push_back(region_nodes(context(bc.body, bc.key), bc.region));
+  for (const LoadSpec& load : scene.loads) s.load_faces.push_back(region_faces(context(load.body, load.key), load.region));
+  return s;
+}
+
+/// Rank 0's selection sent to every rank of `comm` (collective).
+void broadcast_selection(RegionSelection& s, const Scene& scene, MPI_Comm comm) {
+  s.condition_nodes.resize(scene.boundary_conditions.size());
+  s.load_faces.resize(scene.loads.size());
+  for (auto& nodes : s.condition_nodes) broadcast_vector(nodes, 0, comm);
+  for (auto& faces : s.load_faces) broadcast_vector(faces, 0, comm);
+}
+
+/// The constants, masses, initial and boundary conditions and loads of the model on `mesh`.
+void complete_model(Model& m, const RegionSelection& selection);
 
 }  // namespace
 
@@ -100,18 +136,25 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
     m.materials.push_back(NeoHookean::from_young_poisson(ms.young, ms.poisson, ms.density));
   int ranks = 1;
   if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
+  std::vector<std::vector<PhysicalGroup>> groups;
+  RegionSelection selection;
   if (ranks == 1) {
-    m.mesh = mesh_bodies(scene, max_elements);
-    complete_model(m);
+    m.mesh = mesh_bodies(scene, max_elements, groups);
+    selection = select_regions(scene, m.mesh, groups);
+    complete_model(m, selection);
   } else if (scene.fracture_enabled()) {
     // Fracture still needs the whole model on every rank (docs/parallel.md "Limits").
-    on_root(comm, [&] { m.mesh = mesh_bodies(scene, max_elements); });
+    on_root(comm, [&] {
+      m.mesh = mesh_bodies(scene, max_elements, groups);
+      selection = select_regions(scene, m.mesh, groups);
+    });
     broadcast_mesh(m.mesh, 0, comm);
-    complete_model(m);
+    broadcast_selection(selection, scene, comm);
+    complete_model(m, selection);
   } else {
     on_root(comm, [&] {
-      m.mesh = mesh_bodies(scene, max_elements);
-      complete_model(m);
+      m.mesh = mesh_bodies(scene, max_elements, groups);
+      complete_model(m, select_regions(scene, m.mesh, groups));
       check_ranks(m, ranks);
     });
     distribute_parts(m, comm);
@@ -121,7 +164,7 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
 
 namespace {
 
-void complete_model(Model& m) {
+void complete_model(Model& m, const RegionSelection& selection) {
   const Scene& scene = m.scene;
   const Mesh& mesh = m.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
@@ -177,42 +220,45 @@ void complete_model(Model& m) {
 
   m.bc_mask.assign(nn, 0);
   m.bc_velocity.assign(nn, Vec3::Zero());
-  // Per node and component, the condition that prescribed it: two that give
-  // one component of one node different values contradict each other (the
-  // last would win silently); the same value twice (overlapping regions that
-  // fix the same corner) is accepted.
-  std::vector<std::array<int, 3>> set_by(scene.boundary_conditions.empty() ? 0 : nn, {-1, -1, -1});
+  m.bc_condition.assign(nn, {-1, -1, -1});
+  // Two conditions that prescribe one component of one node contradict each
+  // other unless they agree (the same quantity, value and amplitude: regions
+  // that overlap where they fix the same corner).
   for (std::size_t k = 0; k < scene.boundary_conditions.size(); ++k) {
     const BoundaryConditionSpec& bc = scene.boundary_conditions[k];
-    Index hits = 0;
-    for (Index i = 0; i < nn; ++i) {
-      if (mesh.node_body[i] != bc.body) continue;
-      const Vec3& X = mesh.reference[i];
-      if ((X.array() < bc.box_lo.array()).any() || (X.array() > bc.box_hi.array()).any()) continue;
-      ++hits;
-      for (int c = 0; c < 3; ++c)
-        if (bc.velocity[c]) {
-          const int first = set_by[i][c];
-          if (first >= 0 && m.bc_velocity[i][c] != *bc.velocity[c]) {
-            const std::string comp = ".velocity[" + std::to_string(c) + "]";
-            std::ostringstream os;
-            os << scene.file << ": " << bc.key << comp << ": prescribes " << *bc.velocity[c] << " m/s on node "
-               << mesh.node_gid[i] << " of body '" << scene.bodies[bc.body].name << "' at (" << X.x() << ", "
-               << X.y() << ", " << X.z() << "), where " << scene.boundary_conditions[first].key << comp
-               << " prescribes " << m.bc_velocity[i][c]
-               << " m/s; expected one value per component of a node (regions that overlap must agree)";
-            throw InputError(os.str());
-          }
-          set_by[i][c] = static_cast<int>(k);
-          m.bc_mask[i] |= static_cast<std::uint8_t>(1u << c);
-          m.bc_velocity[i][c] = *bc.velocity[c];
-          m.initial_velocity[i][c] = *bc.velocity[c];
+    for (Index i : selection.condition_nodes[k])
+      for (int c = 0; c < 3; ++c) {
+        if (!bc.value[c]) continue;
+        const int first = m.bc_condition[i][c];
+        if (first >= 0) {
+          const BoundaryConditionSpec& other = scene.boundary_conditions[first];
+          if (other.displacement == bc.displacement && m.bc_velocity[i][c] == *bc.value[c] &&
+              other.amplitude == bc.amplitude)
+            continue;
+          const std::string comp = "[" + std::to_string(c) + "]";
+          const Vec3& X = mesh.reference[i];
+          std::ostringstream os;
+          os << scene.file << ": " << bc.key << "." << bc.quantity() << comp << ": prescribes " << *bc.value[c] << " "
+             << bc.unit() << " on node " << mesh.node_gid[i] << " of body '" << scene.bodies[bc.body].name << "' at ("
+             << X.x() << ", " << X.y() << ", " << X.z() << "), where " << other.key << "." << other.quantity() << comp
+             << " prescribes " << m.bc_velocity[i][c] << " " << other.unit()
+             << (other.displacement == bc.displacement && m.bc_velocity[i][c] == *bc.value[c]
+                     ? " with another amplitude"
+                     : "")
+             << "; expected one value per component of a node (regions that overlap must agree)";
+          throw InputError(os.str());
         }
-    }
-    if (hits == 0)
-      throw InputError(scene.file + ": " + bc.key + ".region: the box holds no node of body '" +
-                       scene.bodies[bc.body].name + "'; expected a box around some of its nodes");
+        m.bc_condition[i][c] = static_cast<std::int32_t>(k);
+        m.bc_mask[i] |= static_cast<std::uint8_t>(1u << c);
+        m.bc_velocity[i][c] = *bc.value[c];
+        m.initial_velocity[i][c] =
+            *bc.value[c] * (bc.displacement ? bc.amplitude.rate(0.0) : bc.amplitude.value(0.0));
+      }
   }
+  m.load_faces.clear();
+  for (std::size_t k = 0; k < selection.load_faces.size(); ++k)
+    for (const BoundaryFace& f : selection.load_faces[k])
+      m.load_faces.push_back({f.element, static_cast<std::int32_t>(f.face), static_cast<std::int32_t>(k)});
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // and initial velocities. Built once, before the run.
 #include <mpi.h>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -29,7 +30,20 @@ struct Model {
 
   std::vector<double> mass;                  ///< lumped nodal mass, kg
   std::vector<std::uint8_t> bc_mask;         ///< per node: bit k set = component k prescribed
-  std::vector<Vec3> bc_velocity;             ///< per node: prescribed velocity components, m/s
+  /// per node: prescribed components at amplitude 1, the velocity (m/s) or
+  /// displacement (m) of the condition bc_condition names
+  std::vector<Vec3> bc_velocity;
+  /// per node and component: the boundary condition (index into
+  /// scene.boundary_conditions) prescribing it, -1 for a free component
+  std::vector<std::array<std::int32_t, 3>> bc_condition;
+  /// A boundary face carrying a load: element, local face (kTetFaces row), load (scene.loads index).
+  struct LoadFace {
+    Index element = 0;
+    std::int32_t face = 0, load = 0;
+  };
+  /// The faces of the scene's loads, by load, then element and local face
+  /// (the whole model's order; a part holds those of its held elements, in that order).
+  std::vector<LoadFace> load_faces;
   std::vector<Vec3> initial_velocity;        ///< per node, m/s
 
   /// Total mass and volume of each body (of the whole model).
@@ -69,7 +83,7 @@ void for_each_array(M& m, F f) {
   f(m.mesh.reference), f(m.mesh.node_gid), f(m.mesh.node_body), f(m.mesh.conn), f(m.mesh.elem_gid);
   f(m.mesh.elem_body), f(m.mesh.elem_material), f(m.mesh.node_elem_offsets), f(m.mesh.node_elem);
   f(m.tet4_Dm_inv), f(m.tet10_ref), f(m.element_volume), f(m.element_node_mass), f(m.mass), f(m.bc_mask);
-  f(m.bc_velocity), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
+  f(m.bc_velocity), f(m.bc_condition), f(m.load_faces), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
   f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index), f(m.part.surface);
 }

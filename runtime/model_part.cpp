@@ -10,6 +10,7 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
+#include "runtime/loads.hpp"
 
 namespace shatter {
 namespace {
@@ -81,6 +82,7 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
     m.mass.push_back(whole.mass[n]);
     m.bc_mask.push_back(whole.bc_mask[n]);
     m.bc_velocity.push_back(whole.bc_velocity[n]);
+    m.bc_condition.push_back(whole.bc_condition[n]);
     m.initial_velocity.push_back(whole.initial_velocity[n]);
     if (whole.bc_mask[n]) part.bc_index.push_back(p.bc_index[n]);
     part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
@@ -105,6 +107,7 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
     }
   }
   mesh.build_node_elements();
+  m.load_faces = held_load_faces(whole.load_faces, part.element_index);
   for (size_t t = 0; t < p.surface.triangles.size(); ++t) {
     const auto& [a, b, c] = p.surface.triangles[t];
     part.surface.push_back({{local[a], local[b], local[c]}, p.surface.body[t]});

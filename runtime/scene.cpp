@@ -281,6 +281,110 @@ StrengthScatter strength_scatter(const Reader& r, const YAML::Node& n, const std
   return s;
 }
 
+
+/// `region`: exactly one of box, physical, face; a face named by the body's shape.
+RegionSpec read_region(const Reader& r, const YAML::Node& n, const std::string& key, const BodySpec& body) {
+  r.only_keys(n, key, {"box", "physical", "face"});
+  if (n.size() != 1) r.fail(key, "exactly one of box, physical, face", n);
+  RegionSpec region;
+  if (const YAML::Node box = n["box"]) {
+    const std::string bk = key + ".box";
+    if (!box.IsSequence() || box.size() != 2) r.fail(bk, "[[xmin, ymin, zmin], [xmax, ymax, zmax]]", box);
+    region.lo = r.vec3(box[0], bk + "[0]");
+    region.hi = r.vec3(box[1], bk + "[1]");
+    if ((region.lo.array() > region.hi.array()).any()) r.fail(bk, "min corner <= max corner", box);
+  } else if (n["physical"]) {
+    region.kind = RegionSpec::Kind::physical;
+    region.name = r.string(n["physical"], key + ".physical");
+    if (body.mesh_file.empty())
+      r.fail(key + ".physical", "{face: NAME} for body '" + body.name + "', a shape (it has no physical groups)",
+             n["physical"]);
+  } else {
+    region.kind = RegionSpec::Kind::face;
+    region.name = r.string(n["face"], key + ".face");
+    if (!body.mesh_file.empty())
+      r.fail(key + ".face", "{physical: NAME} for body '" + body.name + "', read from a mesh file (its faces have no names)",
+             n["face"]);
+    const std::vector<std::string> names = shape_face_names(body.shape);
+    if (std::find(names.begin(), names.end(), region.name) == names.end()) {
+      std::string list;
+      for (const std::string& f : names) list += (list.empty() ? "" : ", ") + f;
+      r.fail(key + ".face", "a face of the " + body.shape.shape + " of body '" + body.name + "': one of " + list,
+             n["face"]);
+    }
+  }
+  return region;
+}
+
+/// `amplitude`: a table [[t0, a0], [t1, a1], ...] (times increasing), or one of
+/// {ramp: t_r}, {smooth_step: [t0, t1]}, {half_sine: [t0, duration]}.
+Amplitude read_amplitude(const Reader& r, const YAML::Node& n, const std::string& key) {
+  const char* forms = "a table [[t0, a0], [t1, a1], ...] or one of {ramp: t_r}, {smooth_step: [t0, t1]}, "
+                      "{half_sine: [t0, duration]}";
+  Amplitude a;
+  if (n.IsSequence()) {
+    a.form = Amplitude::Form::table;
+    if (n.size() < 2) r.fail(key, "a table of at least 2 points [[t0, a0], [t1, a1], ...]", n);
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      if (!n[i].IsSequence() || n[i].size() != 2) r.fail(k, "a point [t, a] (s, factor)", n[i]);
+      const double t = r.number(n[i][0], k + "[0]"), v = r.number(n[i][1], k + "[1]");
+      if (i > 0 && !(t > a.table.back()[0])) r.fail(k + "[0]", "a time after the previous point's", n[i][0]);
+      a.table.push_back({t, v});
+    }
+    return a;
+  }
+  if (!n.IsMap() || n.size() != 1) r.fail(key, forms, n);
+  r.only_keys(n, key, {"ramp", "smooth_step", "half_sine"});
+  if (n["ramp"]) {
+    a.form = Amplitude::Form::ramp;
+    a.t1 = r.positive(n["ramp"], key + ".ramp");
+    return a;
+  }
+  const bool smooth = static_cast<bool>(n["smooth_step"]);
+  const std::string k = key + (smooth ? ".smooth_step" : ".half_sine");
+  const YAML::Node pair = smooth ? n["smooth_step"] : n["half_sine"];
+  if (!pair.IsSequence() || pair.size() != 2)
+    r.fail(k, smooth ? "[t0, t1] (s), t0 < t1" : "[t0, duration] (s), duration > 0", pair);
+  a.form = smooth ? Amplitude::Form::smooth_step : Amplitude::Form::half_sine;
+  a.t0 = r.number(pair[0], k + "[0]");
+  if (smooth) {
+    a.t1 = r.number(pair[1], k + "[1]");
+    if (!(a.t1 > a.t0)) r.fail(k + "[1]", "an end time after t0", pair[1]);
+  } else {
+    a.t1 = a.t0 + r.positive(pair[1], k + "[1]");
+  }
+  return a;
+}
+
+/// The body named by `key`.body.
+int read_body_name(const Reader& r, const YAML::Node& c, const std::string& key, const Scene& s) {
+  const std::string body = r.string(r.required(c, key, "body"), key + ".body");
+  for (std::size_t k = 0; k < s.bodies.size(); ++k)
+    if (s.bodies[k].name == body) return static_cast<int>(k);
+  r.fail(key + ".body", "the name of a body", c["body"]);
+}
+
+/// What a condition or a load (`key`, a mapping with `keys`) acts on: its body and region.
+template <class Spec>
+Spec read_acting_on(const Reader& r, const YAML::Node& c, const std::string& key, const Scene& s,
+                    std::initializer_list<const char*> keys) {
+  r.only_keys(c, key, keys);
+  Spec spec;
+  spec.key = key;
+  spec.body = read_body_name(r, c, key, s);
+  spec.region = read_region(r, r.required(c, key, "region"), key + ".region", s.bodies[spec.body]);
+  return spec;
+}
+
+/// Whether `c` gives key a (else b): exactly one of them, `expected` describing both.
+bool read_either(const Reader& r, const YAML::Node& c, const std::string& key, const char* a, const char* b,
+                 const std::string& expected) {
+  if (c[a] && c[b]) r.fail(key, std::string("expected one of ") + a + " or " + b + ", not both");
+  if (!c[a] && !c[b]) r.fail(key, "expected one of " + expected + " (a required key)");
+  return static_cast<bool>(c[a]);
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
@@ -322,7 +426,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     refuse_duplicate_keys(value, o.substr(0, eq), "--set " + o);
     target = value;
   }
-  r.only_keys(root, "", {"name", "time", "output", "materials", "bodies", "boundary_conditions", "contact",
+  r.only_keys(root, "", {"name", "time", "output", "materials", "bodies", "boundary_conditions", "loads", "contact",
                          "gravity", "checkpoint"});
   Scene s;
   s.file = path;
@@ -392,7 +496,8 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::string key = "bodies[" + std::to_string(i) + "]";
     const YAML::Node b = bodies[i];
-    r.only_keys(b, key, {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient"});
+    r.only_keys(b, key,
+                {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient", "rigid"});
     BodySpec body;
     body.key = key;
     body.name = b["name"] ? r.string(b["name"], key + ".name") : "body" + std::to_string(i);
@@ -425,43 +530,71 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     if (b["initial_velocity"]) body.initial_velocity = r.vec3(b["initial_velocity"], key + ".initial_velocity");
     if (b["angular_velocity"]) body.angular_velocity = r.vec3(b["angular_velocity"], key + ".angular_velocity");
     if (b["velocity_gradient"]) body.velocity_gradient = r.mat3(b["velocity_gradient"], key + ".velocity_gradient");
+    if (const YAML::Node rigid = b["rigid"]) {
+      if (!rigid.IsScalar() || (rigid.Scalar() != "true" && rigid.Scalar() != "false"))
+        r.fail(key + ".rigid", "true or false", rigid);
+      body.rigid = rigid.Scalar() == "true";
+      if (body.rigid && (body.angular_velocity != Vec3::Zero() || body.velocity_gradient))
+        r.fail(key + ".rigid",
+               "false with angular_velocity or velocity_gradient (a rigid body translates; rotation is not built yet)",
+               rigid);
+    }
     s.bodies.push_back(body);
   }
   for (const auto& b : s.bodies)
     if (b.mesh_file.empty() && b.shape.order != s.bodies[0].shape.order)
       r.fail(b.key + ".mesh.order", "the same element order for every body");
 
+  // A rigid body: its initial velocity prescribed on every node, before any condition.
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (!s.bodies[i].rigid) continue;
+    BoundaryConditionSpec bc;
+    bc.key = s.bodies[i].key + ".rigid";
+    bc.body = static_cast<int>(i);
+    bc.region.lo = Vec3::Constant(-HUGE_VAL);
+    bc.region.hi = Vec3::Constant(HUGE_VAL);
+    for (int k = 0; k < 3; ++k) bc.value[k] = s.bodies[i].initial_velocity[k];
+    s.boundary_conditions.push_back(bc);
+  }
   if (const YAML::Node bcs = root["boundary_conditions"]) {
     if (!bcs.IsSequence()) r.fail("boundary_conditions", "a list of boundary conditions", bcs);
     for (std::size_t i = 0; i < bcs.size(); ++i) {
       const std::string key = "boundary_conditions[" + std::to_string(i) + "]";
       const YAML::Node c = bcs[i];
-      r.only_keys(c, key, {"body", "region", "velocity"});
-      BoundaryConditionSpec bc;
-      bc.key = key;
-      const std::string body = r.string(r.required(c, key, "body"), key + ".body");
-      bc.body = -1;
-      for (std::size_t k = 0; k < s.bodies.size(); ++k)
-        if (s.bodies[k].name == body) bc.body = static_cast<int>(k);
-      if (bc.body < 0) r.fail(key + ".body", "the name of a body", c["body"]);
-      const YAML::Node region = r.required(c, key, "region");
-      r.only_keys(region, key + ".region", {"box"});
-      const YAML::Node box = r.required(region, key + ".region", "box");
-      const std::string bk = key + ".region.box";
-      if (!box.IsSequence() || box.size() != 2) r.fail(bk, "[[xmin, ymin, zmin], [xmax, ymax, zmax]]", box);
-      bc.box_lo = r.vec3(box[0], bk + "[0]");
-      bc.box_hi = r.vec3(box[1], bk + "[1]");
-      if ((bc.box_lo.array() > bc.box_hi.array()).any()) r.fail(bk, "min corner <= max corner", box);
-      const YAML::Node v = r.required(c, key, "velocity");
-      if (!v.IsSequence() || v.size() != 3) r.fail(key + ".velocity", "[vx, vy, vz] with null for free components", v);
+      BoundaryConditionSpec bc = read_acting_on<BoundaryConditionSpec>(
+          r, c, key, s, {"body", "region", "velocity", "displacement", "amplitude"});
+      bc.displacement = !read_either(r, c, key, "velocity", "displacement",
+                                     "velocity [vx, vy, vz] or displacement [ux, uy, uz]");
+      const std::string vk = key + "." + bc.quantity();
+      const YAML::Node v = c[bc.quantity()];
+      if (!v.IsSequence() || v.size() != 3)
+        r.fail(vk, std::string(bc.displacement ? "[ux, uy, uz]" : "[vx, vy, vz]") + " with null for free components",
+               v);
       bool any = false;
       for (int k = 0; k < 3; ++k)
         if (!v[k].IsNull()) {
-          bc.velocity[k] = r.number(v[k], key + ".velocity[" + std::to_string(k) + "]");
+          bc.value[k] = r.number(v[k], vk + "[" + std::to_string(k) + "]");
           any = true;
         }
-      if (!any) r.fail(key + ".velocity", "at least one prescribed (non-null) component", v);
+      if (!any) r.fail(vk, "at least one prescribed (non-null) component", v);
+      if (c["amplitude"]) bc.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
       s.boundary_conditions.push_back(bc);
+    }
+  }
+
+  if (const YAML::Node loads = root["loads"]) {
+    if (!loads.IsSequence()) r.fail("loads", "a list of loads {body, region, pressure or traction, amplitude}", loads);
+    for (std::size_t i = 0; i < loads.size(); ++i) {
+      const std::string key = "loads[" + std::to_string(i) + "]";
+      const YAML::Node c = loads[i];
+      LoadSpec load =
+          read_acting_on<LoadSpec>(r, c, key, s, {"body", "region", "pressure", "traction", "amplitude"});
+      if (read_either(r, c, key, "pressure", "traction", "pressure (Pa) or traction ([tx, ty, tz], Pa)"))
+        load.pressure = r.number(c["pressure"], key + ".pressure");
+      else
+        load.traction = r.vec3(c["traction"], key + ".traction");
+      if (c["amplitude"]) load.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
+      s.loads.push_back(load);
     }
   }
 

@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "fracture/strength_scatter.hpp"
+#include "kernels/amplitude.hpp"
 #include "kernels/dcr.hpp"
 #include "kernels/types.hpp"
 #include "mesh/gmsh_input.hpp"
+#include "runtime/regions.hpp"
 
 namespace shatter {
 
@@ -40,13 +42,33 @@ struct BodySpec {
   Vec3 initial_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Mat3> velocity_gradient;
+  /// bodies[i].rigid: the body moves with its initial velocity for ever (a condition
+  /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions):
+  /// infinite mass in DCR, its contact impulses' work in external_work.
+  bool rigid = false;
   std::string key;             ///< "bodies[i]", for messages
 };
 
 struct BoundaryConditionSpec {
   int body = 0;
-  Vec3 box_lo, box_hi;                          ///< nodes inside (inclusive) get the velocity
-  std::array<std::optional<double>, 3> velocity;  ///< prescribed components, m/s
+  RegionSpec region;                           ///< the nodes it prescribes
+  bool displacement = false;                   ///< `value` is a displacement (m), else a velocity (m/s)
+  std::array<std::optional<double>, 3> value;  ///< prescribed components (null = free), times amplitude(t)
+  Amplitude amplitude;
+  std::string key;
+  /// "velocity" or "displacement": the key of the values.
+  const char* quantity() const { return displacement ? "displacement" : "velocity"; }
+  const char* unit() const { return displacement ? "m" : "m/s"; }
+};
+
+/// A surface load (loads[i]): a follower pressure or a dead traction on the
+/// boundary faces of a region, times amplitude(t) (kernels/surface_load.hpp).
+struct LoadSpec {
+  int body = 0;
+  RegionSpec region;
+  std::optional<double> pressure;  ///< Pa, positive pushing into the body
+  std::optional<Vec3> traction;    ///< Pa (N per m^2 of reference area), global frame
+  Amplitude amplitude;
   std::string key;
 };
 
@@ -76,6 +98,7 @@ struct Scene {
   std::vector<MaterialSpec> materials;
   std::vector<BodySpec> bodies;
   std::vector<BoundaryConditionSpec> boundary_conditions;
+  std::vector<LoadSpec> loads;
   std::optional<ContactSpec> contact;
   Vec3 gravity = Vec3::Zero();
   std::optional<CheckpointSpec> checkpoint;

@@ -29,6 +29,41 @@ class KeyWriter {
   std::ostringstream out_;
 };
 
+/// A box as before regions had names (a checkpoint's keys stay comparable).
+void region_keys(KeyWriter& w, const RegionSpec& r, const std::string& key) {
+  if (r.kind == RegionSpec::Kind::box) {
+    w.vec3(key + ".box[0]", r.lo);
+    w.vec3(key + ".box[1]", r.hi);
+  } else {
+    w.text(key + (r.kind == RegionSpec::Kind::physical ? ".physical" : ".face"), r.name);
+  }
+}
+
+/// Nothing for the constant amplitude (the keys of scenes before amplitudes).
+void amplitude_keys(KeyWriter& w, const Amplitude& a, const std::string& key) {
+  switch (a.form) {
+    case Amplitude::Form::constant:
+      return;
+    case Amplitude::Form::table:
+      for (size_t k = 0; k < a.table.size(); ++k) {
+        w.number(key + "[" + std::to_string(k) + "][0]", a.table[k][0]);
+        w.number(key + "[" + std::to_string(k) + "][1]", a.table[k][1]);
+      }
+      return;
+    case Amplitude::Form::ramp:
+      w.number(key + ".ramp", a.t1);
+      return;
+    case Amplitude::Form::smooth_step:
+      w.number(key + ".smooth_step[0]", a.t0);
+      w.number(key + ".smooth_step[1]", a.t1);
+      return;
+    case Amplitude::Form::half_sine:
+      w.number(key + ".half_sine[0]", a.t0);
+      w.number(key + ".half_sine[1]", a.t1 - a.t0);
+      return;
+  }
+}
+
 void shape_keys(KeyWriter& w, const ShapeSpec& s, const std::string& key) {
   w.text(key + ".shape", s.shape);
   w.vec3(key + ".size", s.size);
@@ -103,15 +138,22 @@ std::string physics_keys(const Scene& s) {
   }
   for (const BoundaryConditionSpec& c : s.boundary_conditions) {
     w.text(c.key + ".body", s.bodies[c.body].name);
-    w.vec3(c.key + ".region.box[0]", c.box_lo);
-    w.vec3(c.key + ".region.box[1]", c.box_hi);
+    region_keys(w, c.region, c.key + ".region");
     for (int k = 0; k < 3; ++k) {
-      const std::string key = c.key + ".velocity[" + std::to_string(k) + "]";
-      if (c.velocity[k])
-        w.number(key, *c.velocity[k]);
+      const std::string key = c.key + "." + c.quantity() + "[" + std::to_string(k) + "]";
+      if (c.value[k])
+        w.number(key, *c.value[k]);
       else
         w.text(key, "null");
     }
+    amplitude_keys(w, c.amplitude, c.key + ".amplitude");
+  }
+  for (const LoadSpec& l : s.loads) {
+    w.text(l.key + ".body", s.bodies[l.body].name);
+    region_keys(w, l.region, l.key + ".region");
+    if (l.pressure) w.number(l.key + ".pressure", *l.pressure);
+    if (l.traction) w.vec3(l.key + ".traction", *l.traction);
+    amplitude_keys(w, l.amplitude, l.key + ".amplitude");
   }
   w.text("contact", s.contact ? "on" : "off");
   if (s.contact) {

@@ -13,6 +13,7 @@
 #include "runtime/diagnosis.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/loads.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
 #include "runtime/timed.hpp"
@@ -56,6 +57,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   }
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
+  if (!model_.load_faces.empty()) loads_ = std::make_unique<SurfaceLoads>(model_);
   if (model_.scene.fracture_enabled()) {
     fracture_ = std::make_unique<FractureStage>(model_, *dec_);
     stress6_.resize(6 * static_cast<size_t>(model_.mesh.num_elements()));
@@ -140,6 +142,14 @@ void Simulation::compute_forces(long step, double time, const std::function<void
     f_ext_[i] = model_.mass[i] * g;
     a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
   });
+  if (loads_) {
+    loads_->compute(x_, time);
+    for (size_t k = 0; k < loads_->nodes().size(); ++k) {
+      const Index i = loads_->nodes()[k];
+      f_ext_[i] += loads_->force()[k];
+      a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
+    }
+  }
   // Prescribed components: no acceleration; the reaction is the force that holds them.
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
     const Index i = bc_nodes_[b];
@@ -165,6 +175,14 @@ void Simulation::step() {
   book_gravity_work();
   compute_forces(step_ + 1, time_ + dt_, [&] { timed(comm_seconds_, [&] { dec_->end_ghost_update(x_); }); });
   if (contact_) book_contact_work();
+  if (loads_) {
+    // The loads' work by the trapezoidal rule, W += (F(n) + F(n+1))/2 . (x(n+1) - x(n)).
+    for (size_t k = 0; k < loads_->nodes().size(); ++k) {
+      const Index i = loads_->nodes()[k];
+      if (dec_->owns_node(i))
+        step_work_[kLoadWork] += 0.5 * (load_force_old_[k] + loads_->force()[k]).dot(x_[i] - load_x_old_[k]);
+    }
+  }
   correct(reaction_old);
   time_ += dt_;
   ++step_;
@@ -173,21 +191,40 @@ void Simulation::step() {
   check_ledger();
 }
 
-void Simulation::half_kick() {
-  const double half = 0.5 * dt_;
+void Simulation::half_kick(bool predicting) {
+  const double half = 0.5 * dt_, end = time_ + dt_;
+  const std::vector<BoundaryConditionSpec>& conditions = model_.scene.boundary_conditions;
+  bc_factor_.resize(conditions.size());
+  for (size_t k = 0; k < conditions.size(); ++k) {
+    const Amplitude& a = conditions[k].amplitude;
+    bc_factor_[k] = conditions[k].displacement ? (predicting ? a.value(end) : a.rate(end))
+                                               : a.value(predicting ? time_ + half : end);
+  }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) {
     v_[i] += half * a_[i];
     if (model_.bc_mask[i])
       for (int c = 0; c < 3; ++c)
-        if (model_.bc_mask[i] & (1u << c)) v_[i][c] = model_.bc_velocity[i][c];
+        if (model_.bc_mask[i] & (1u << c)) {
+          const int k = model_.bc_condition[i][c];
+          const double value = model_.bc_velocity[i][c] * bc_factor_[k];
+          // A displacement is reached at the end of the step from x(n).
+          v_[i][c] = predicting && conditions[k].displacement
+                         ? (model_.mesh.reference[i][c] + value - x_[i][c]) / dt_
+                         : value;
+        }
   });
 }
 
 void Simulation::predict() {
-  half_kick();
+  half_kick(true);
   bc_dx_.resize(bc_nodes_.size());
   for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
   if (contact_) x_prev_ = x_;
+  if (loads_) {
+    load_x_old_.resize(loads_->nodes().size());
+    for (size_t k = 0; k < load_x_old_.size(); ++k) load_x_old_[k] = x_[loads_->nodes()[k]];
+    load_force_old_ = loads_->force();
+  }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) { x_[i] += dt_ * v_[i]; });
 }
 
@@ -201,13 +238,14 @@ void Simulation::resolve_contact() {
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
   for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
-  const DcrResult r = contact_->apply(x_prev_, x_, v_, contact_inv_mass_, dt_);
+  const DcrResult r = contact_->apply(x_prev_, x_, v_, inv_mass_, dt_, model_.bc_mask);
   for (size_t k = 0; k < vertices.size(); ++k) {
     contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
     contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
   }
   ledger_.contacts = r.contacts;
   ledger_.contact_dissipated += r.dissipated;
+  ledger_.external_work += r.support_work;
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
       throw Error(sweep_cap_diagnosis(model_, x_, contact_->candidates(), r, step_ + 1, time_ + dt_));
@@ -243,7 +281,7 @@ void Simulation::book_contact_work() {
 }
 
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
-  half_kick();
+  half_kick(false);
   // The reactions' work by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
   for (size_t b = 0; b < bc_nodes_.size(); ++b)
     if (dec_->owns_node(bc_nodes_[b]))
@@ -288,15 +326,16 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   const Index n = model_.mesh.num_nodes();
   for (auto* a : {&x_, &v_, &a_, &f_int_, &f_ext_, &model_.bc_velocity, &model_.initial_velocity}) a->resize(n);
   model_.bc_mask.resize(n);
+  model_.bc_condition.resize(n);
   model_.mass.resize(n);
   inv_mass_.resize(n);
-  if (contact_) contact_inv_mass_.resize(n);
   std::vector<Index> touched;
   for (const auto& [child, parent] : new_nodes) {
     x_[child] = x_[parent];
     v_[child] = v_[parent];
     model_.bc_mask[child] = model_.bc_mask[parent];
     model_.bc_velocity[child] = model_.bc_velocity[parent];
+    model_.bc_condition[child] = model_.bc_condition[parent];
     model_.initial_velocity[child] = model_.initial_velocity[parent];
     if (model_.bc_mask[child]) {
       bc_nodes_.push_back(child);
@@ -308,10 +347,8 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   recompute_node_masses(model_, touched);
-  for (Index i : touched) {
-    inv_mass_[i] = 1.0 / model_.mass[i];
-    if (contact_) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
-  }
+  for (Index i : touched) inv_mass_[i] = 1.0 / model_.mass[i];
+  if (loads_) loads_->rebuild();
 }
 
 void Simulation::node_arrays_from_model() {
@@ -321,11 +358,6 @@ void Simulation::node_arrays_from_model() {
   for (Index i = 0; i < n; ++i) {
     inv_mass_[i] = 1.0 / model_.mass[i];
     if (model_.bc_mask[i]) bc_nodes_.push_back(i);
-  }
-  // DCR treats a node with any prescribed component as immovable.
-  if (contact_) {
-    contact_inv_mass_.resize(n);
-    for (Index i = 0; i < n; ++i) contact_inv_mass_[i] = model_.bc_mask[i] ? 0.0 : inv_mass_[i];
   }
 }
 
@@ -355,7 +387,8 @@ void Simulation::update_ledger() {
   ledger_.strain = t[kStrain].value();
   ledger_.cohesive_stored = t[kStored].value();
   ledger_.cohesive_dissipated = t[kDissipated].value();
-  ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value();
+  ledger_.external_work +=
+      t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value() + t[kLocal + kLoadWork].value();
   ledger_.contact_work += t[kLocal + kContactWork].value();
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +

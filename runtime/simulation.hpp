@@ -37,6 +37,7 @@ class FieldWriter;
 class FailureChannel;
 class CsvWriter;
 class ContactStage;
+class SurfaceLoads;
 class Decomposition;
 struct SharedNodes;
 struct DecompositionStats;
@@ -125,8 +126,11 @@ class Simulation {
 
  private:
   // The stages of step(), in order.
-  /// v(n+1/2) = v(n) + dt/2 a(n) on the touched nodes (prescribed components set).
-  void half_kick();
+  /// v += dt/2 a on the touched nodes, prescribed components set: at the
+  /// mid step (`predicting`: a velocity times its amplitude there, or the
+  /// velocity that reaches a displacement times its amplitude at the end of
+  /// the step) or at the end (a velocity, or a displacement's rate, there).
+  void half_kick(bool predicting);
   /// half_kick, then x(n+1) = x(n) + dt v(n+1/2); keeps x(n) for contact and
   /// the prescribed nodes' displacements for the reactions' work.
   void predict();
@@ -181,7 +185,7 @@ class Simulation {
   /// The step's work terms, exact sums over this rank's owned nodes, summed
   /// over the ranks by update_ledger: gravity's work, the reactions' work and
   /// the contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work).
-  enum StepWork { kGravityWork, kReactionWork, kContactWork, kStepWorks };
+  enum StepWork { kGravityWork, kReactionWork, kContactWork, kLoadWork, kStepWorks };
   /// Accumulators of update_ledger's one reduction per step: kinetic energy,
   /// momentum (3), angular momentum (3), strain, cohesive stored and
   /// dissipated, and the step's works.
@@ -201,6 +205,9 @@ class Simulation {
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
   std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
   std::vector<Vec3> bc_dx_;            ///< per bc node: its displacement over the step under way, m
+  std::vector<double> bc_factor_;      ///< per boundary condition: its values' factor at the half step under way
+  std::unique_ptr<SurfaceLoads> loads_;  ///< null without loads
+  std::vector<Vec3> load_x_old_, load_force_old_;  ///< per loaded node: x(n) and its load at x(n), for the work
   double time_ = 0, dt_ = 0, stable_dt_ = 0;
   StepControl step_control_;
   long step_ = 0;
@@ -211,7 +218,6 @@ class Simulation {
   double total0_ = 0, energy_scale_ = 0;
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
-  std::vector<double> contact_inv_mass_;    ///< 0 on nodes with a prescribed component
   std::vector<Vec3> contact_dx_,
       contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block

@@ -159,7 +159,7 @@ CrackArea Simulation::write_fragments() {
 long Simulation::loop_bytes() const {
   auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
   return static_cast<long>(model_bytes(model_)) + b(x_) + b(v_) + b(a_) + b(f_int_) + b(f_ext_) + b(inv_mass_) +
-         b(bc_nodes_) + b(reaction_) + b(x_prev_) + b(contact_inv_mass_) + b(stress6_);
+         b(bc_nodes_) + b(reaction_) + b(x_prev_) + b(stress6_);
 }
 
 void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs,

@@ -10,6 +10,8 @@
 #include "runtime/fracture_stage.hpp"
 #include "runtime/row_blocks.hpp"
 #include "runtime/simulation.hpp"
+
+#include "runtime/loads.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -109,6 +111,11 @@ void Simulation::restore_state(const SimulationState& s) {
   f_ext_ = s.f_ext;
   reaction_ = s.reaction;
   restore_scalars(s);
+  if (loads_) {
+    // The loads at x(n), which the next step's work starts from.
+    loads_->rebuild();
+    loads_->compute(x_, time_);
+  }
 }
 
 void Simulation::restore_scalars(const SimulationState& s) {

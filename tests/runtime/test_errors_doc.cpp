@@ -5,6 +5,7 @@
 // the exact list of bad-input messages, and stays so.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -99,6 +100,11 @@ void write_bad_files(const fs::path& dir, const std::string& base_scene) {
                                        << "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
                                           "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n";
   std::ofstream(dir / "garbage.msh") << "this is not a mesh\n";
+  // A good tetrahedron with named physical groups: a point, a surface, the volume.
+  std::ofstream(dir / "tet.msh") << header
+                                 << "$PhysicalNames\n3\n0 1 \"corner\"\n2 2 \"bottom\"\n3 3 \"solid\"\n$EndPhysicalNames\n"
+                                    "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+                                    "$Elements\n3\n1 15 2 1 1 1\n2 2 2 2 2 1 3 2\n3 4 2 3 3 1 2 3 4\n$EndElements\n";
   std::ofstream(dir / "v40.msh") << "$MeshFormat\n4 0 8\n$EndMeshFormat\n";
   std::ofstream(dir / "cut.msh") << header << "$Elements\n2\n1 4 2 1 1 1 2 3 4\n";
   std::ofstream(dir / "unknown_type.msh") << header << "$Elements\n1\n3 777 0 1 2 3\n$EndElements\n";
@@ -172,7 +178,8 @@ TEST(ErrorsDoc, EveryMessageIsTheBinarys) {
   const Page page = read_page(fs::path(SHATTER_SOURCE_DIR) / "docs" / "errors.md");
   ASSERT_FALSE(page.base_scene.empty()) << "docs/errors.md has no ```yaml base scene";
   ASSERT_GT(page.rows.size(), 30u);
-  const fs::path dir = fs::temp_directory_path() / "shatter_errors_doc";
+  // One folder per process: the suites of other builds on the machine run this test too.
+  const fs::path dir = fs::temp_directory_path() / ("shatter_errors_doc_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "scene.yaml") << page.base_scene;
@@ -187,4 +194,5 @@ TEST(ErrorsDoc, EveryMessageIsTheBinarys) {
     EXPECT_EQ(status, row.status) << row.what << ": " << row.command;
     EXPECT_EQ(line, expand(row.message)) << row.what << ": " << row.command;
   }
+  fs::remove_all(dir);
 }

@@ -49,6 +49,7 @@ TEST(Simulation, AffinePatchTestIsReproducedToRoundOff) {
     L << 30, 10, -5, 0, -20, 8, 4, 6, 15;  // 1/s
     const Vec3 v0(1.0, -2.0, 0.5);
     std::vector<char> interior(m.mesh.num_nodes(), 1);
+    m.scene.boundary_conditions.emplace_back();  // a constant velocity, per node below
     for (Index i = 0; i < m.mesh.num_nodes(); ++i) {
       const Vec3& X = m.mesh.reference[i];
       if ((X.cwiseAbs().array() > 0.01 - 1e-9).any()) interior[i] = 0;
@@ -56,6 +57,7 @@ TEST(Simulation, AffinePatchTestIsReproducedToRoundOff) {
       if (!interior[i]) {
         m.bc_mask[i] = 7;
         m.bc_velocity[i] = v0 + L * X;
+        m.bc_condition[i] = {0, 0, 0};
       }
     }
     Simulation sim(m, {});
