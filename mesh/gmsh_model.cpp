@@ -3,7 +3,6 @@
 #include <gmsh.h>
 
 #include <algorithm>
-#include <exception>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -87,7 +86,7 @@ std::string physical_volumes_of(const std::set<int>& volumes) {
 
 }  // namespace
 
-GmshSession::GmshSession() : lock_(gmsh_mutex()), exceptions_(std::uncaught_exceptions()) {
+GmshSession::GmshSession() : lock_(gmsh_mutex()) {
   if (!gmsh_initialized()) gmsh::initialize(0, nullptr, false);
   gmsh_initialized() = true;
   gmsh::option::setNumber("General.Terminal", 0);
@@ -97,7 +96,9 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), exceptions_(std::uncaught_exce
 }
 
 GmshSession::~GmshSession() {
-  if (std::uncaught_exceptions() > exceptions_) {
+  std::string gmsh_error;
+  gmsh::logger::getLastError(gmsh_error);
+  if (!gmsh_error.empty()) {
     gmsh::finalize();
     gmsh_initialized() = false;
   } else {
