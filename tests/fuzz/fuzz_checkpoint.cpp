@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "checkpoint_seed_scenes.hpp"
+
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/model.hpp"
@@ -26,33 +28,11 @@
 
 namespace {
 
-// The seeds were written by `shatter run` from these two texts (tests/fuzz/README.md).
-const char* const kScenes[] = {
-    "name: fuzz_checkpoint\n"
-    "time: {end: 1.0e-6}\n"
-    "materials:\n"
-    "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-    "bodies:\n"
-    "  - name: b\n"
-    "    material: steel\n"
-    "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}\n"
-    "    initial_velocity: [1, 0, 0]\n",
-    "name: fuzz_checkpoint\n"
-    "time: {end: 1.0e-6}\n"
-    "materials:\n"
-    "  glass: {model: neo_hookean, density: 2500, youngs_modulus: 70.0e9, poisson_ratio: 0.22,\n"
-    "          fracture: {strength: 1.0e6, energy: 1.0}}\n"
-    "bodies:\n"
-    "  - name: b\n"
-    "    material: glass\n"
-    "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}\n"
-    "    velocity_gradient: [[2000, 0, 0], [0, 0, 0], [0, 0, 0]]\n",
-};
 
 std::vector<shatter::Model>& models() {
   static std::vector<shatter::Model> m = [] {
     std::vector<shatter::Model> out;
-    for (const char* text : kScenes) out.push_back(shatter::build_model(shatter::parse_scene(text, "fuzz_checkpoint.yaml")));
+    for (const char* text : shatter::test::kCheckpointSeedScenes) out.push_back(shatter::build_model(shatter::parse_scene(text, "fuzz_checkpoint.yaml")));
     return out;
   }();
   return m;

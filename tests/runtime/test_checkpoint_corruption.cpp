@@ -7,6 +7,7 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include "fuzz/checkpoint_seed_scenes.hpp"
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/model.hpp"
@@ -82,6 +83,17 @@ haddr_t dataset_offset(const std::string& bytes, const char* name) {
   return at;
 }
 
+
+/// Writes `version` into the root attribute of the checkpoint `file`.
+void set_version(const fs::path& file, std::int64_t version) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t root = H5Gopen2(f, "/", H5P_DEFAULT);
+  const hid_t a = H5Aopen(root, "version", H5P_DEFAULT);
+  EXPECT_GE(H5Awrite(a, H5T_NATIVE_INT64, &version), 0);
+  H5Aclose(a);
+  H5Gclose(root);
+  H5Fclose(f);
+}
 
 }  // namespace
 
@@ -168,12 +180,9 @@ TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
   const fs::path file = c.dir / "version2.h5";
   std::ofstream(file, std::ios::binary | std::ios::trunc) << c.a;
   {
+    set_version(file, 2);
     const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
     const hid_t root = H5Gopen2(f, "/", H5P_DEFAULT);
-    const std::int64_t two = 2;
-    const hid_t version = H5Aopen(root, "version", H5P_DEFAULT);
-    EXPECT_GE(H5Awrite(version, H5T_NATIVE_INT64, &two), 0);
-    H5Aclose(version);
     for (const char* name : {"physics", "scene_fingerprint", "history_every", "state_fnv1a64"})
       EXPECT_GE(H5Adelete(root, name), 0) << name;
     const hid_t ledger = H5Gopen2(root, "ledger", H5P_DEFAULT);
@@ -201,33 +210,13 @@ TEST(CheckpointCorruption, VersionTwoIsReadWithoutThePhysicsCheck) {
 // fracture scene, a version 5 file, is read; relabelled version 4, refused).
 TEST(CheckpointCorruption, OldFractureStateIsRefused) {
   const fs::path seed = fs::path(SHATTER_SOURCE_DIR) / "tests" / "fuzz" / "seeds" / "checkpoint" / "fracture.h5";
-  const Model model = build_model(parse_scene("name: fuzz_checkpoint\n"
-                                              "time: {end: 1.0e-6}\n"
-                                              "materials:\n"
-                                              "  glass: {model: neo_hookean, density: 2500, youngs_modulus: 70.0e9, "
-                                              "poisson_ratio: 0.22,\n"
-                                              "          fracture: {strength: 1.0e6, energy: 1.0}}\n"
-                                              "bodies:\n"
-                                              "  - name: b\n"
-                                              "    material: glass\n"
-                                              "    mesh: {shape: box, size: [0.01, 0.01, 0.01], element_size: 0.005}\n"
-                                              "    velocity_gradient: [[2000, 0, 0], [0, 0, 0], [0, 0, 0]]\n",
-                                              "fuzz_checkpoint.yaml"));
+  const Model model = build_model(parse_scene(test::kCheckpointSeedScenes[1], "fuzz_checkpoint.yaml"));
   const SimulationState s = read_checkpoint(seed, model);
   ASSERT_TRUE(s.fracture.has_value());
   EXPECT_GT(s.fracture->cohesive_facet_gid.size(), 0u);
   const fs::path file = checkpoints().dir / "version4_fracture.h5";
   fs::copy_file(seed, file, fs::copy_options::overwrite_existing);
-  {
-    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    const hid_t root = H5Gopen2(f, "/", H5P_DEFAULT);
-    const std::int64_t four = 4;
-    const hid_t version = H5Aopen(root, "version", H5P_DEFAULT);
-    EXPECT_GE(H5Awrite(version, H5T_NATIVE_INT64, &four), 0);
-    H5Aclose(version);
-    H5Gclose(root);
-    H5Fclose(f);
-  }
+  set_version(file, 4);
   try {
     read_checkpoint(file, model);
     ADD_FAILURE() << "a version 4 fracture state was read";
