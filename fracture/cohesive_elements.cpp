@@ -71,9 +71,9 @@ FacetKinematics facet_kinematics(const CohesiveElements& coh, Index c, int k,
 struct ShareView {
   CohesiveShare share;
   Index all;
-  Index count() const { return share.computed.empty() && share.counted.empty() ? all : static_cast<Index>(share.computed.size()); }
-  Index operator[](Index i) const { return share.computed.empty() ? i : share.computed[i]; }
-  bool counted(Index i) const { return share.counted.empty() || share.counted[i]; }
+  Index count() const { return share.every ? all : static_cast<Index>(share.computed.size()); }
+  Index operator[](Index i) const { return share.every ? i : share.computed[i]; }
+  bool counted(Index i) const { return share.every || share.counted[i]; }
 };
 
 /// Adds the forces of the elements at positions [first, last) of `which`

@@ -75,11 +75,13 @@ Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements&
 /// A rank's share of the cohesive elements (MPI, docs/parallel.md "Cohesive
 /// elements on ranks"): `computed`, ascending, the elements it computes (those
 /// with a node it integrates); `counted[i]` whether computed[i] is its own
-/// (its energies and decisions are this rank's). Empty spans: every element,
-/// all counted (one rank).
+/// (its energies and decisions are this rank's). `every` (the default, one
+/// rank): every element, all counted, the spans unused. A rank's share may be
+/// empty: then it computes nothing.
 struct CohesiveShare {
   std::span<const Index> computed;
   std::span<const std::uint8_t> counted;
+  bool every = true;
 };
 
 /// Energies of the cohesive elements, J, summed exactly over the counted

@@ -158,7 +158,7 @@ Index FractureStage::release(std::span<const Index> facets) {
 
 std::vector<double> FractureStage::owned_delta_max(const FractureState& from, std::vector<Index>& rows) const {
   rows.clear();
-  const bool all = computed_.empty();
+  const bool all = !dec_.distributed();
   const auto saved = static_cast<Index>(from.cohesive_facet_gid.size());
   const Index n = all ? saved : static_cast<Index>(computed_.size());
   std::vector<double> values;

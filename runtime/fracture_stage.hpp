@@ -165,10 +165,10 @@ class FractureStage {
   std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
   double weakest_facet_ = 0;            ///< min of facet_strength_, Pa
   FractureLaws laws() const { return {laws_, facet_strength_, weakest_facet_}; }
-  /// share_with's lists (empty on one rank: every element, all owned).
+  /// share()'s lists (unused on one rank: every element, all owned).
   std::vector<Index> computed_;
   std::vector<std::uint8_t> owned_;
-  CohesiveShare mine() const { return {computed_, owned_}; }
+  CohesiveShare mine() const { return {computed_, owned_, !dec_.distributed()}; }
   double check_seconds_ = 0;
   long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
   std::unique_ptr<FragmentLabels> labeler_;  ///< from the first share_with

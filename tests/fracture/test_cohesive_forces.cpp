@@ -248,6 +248,12 @@ TEST(CohesiveForces, PulledFacetDissipatesGcTimesArea) {
   for (const Vec3& fi : f_free) EXPECT_EQ(fi.norm(), 0.0);
   EXPECT_EQ(e_free.stored.value(), 0.0);
   EXPECT_CLOSE(e_free.dissipated.value(), expected, 1e-15, 0);
+  // A rank whose share is empty (no cohesive element around its nodes)
+  // computes and counts nothing: not every element.
+  const CohesiveShare none{{}, {}, false};
+  const CohesiveEnergy e_none = cohesive_forces(m, t, coh, laws, x, f_free, none);
+  EXPECT_EQ(e_none.dissipated.value(), 0.0);
+  EXPECT_TRUE(crack_area(m, t, coh, laws, one_piece, none).debonded.value() == 0.0);
 }
 
 TEST(CohesiveForces, PrescribedMixedOpeningWorkIsGcTimesAreaTet4AndTet10) {
