@@ -315,11 +315,6 @@ std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
   return allgather_of(mine, MPI_INT, comm_, size_);
 }
 
-std::vector<double> Decomposition::allgather(std::span<const double> mine) const {
-  if (size_ == 1) return {mine.begin(), mine.end()};
-  return allgather_of(mine, MPI_DOUBLE, comm_, size_);
-}
-
 std::vector<GlobalId> Decomposition::allgather(std::span<const GlobalId> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   static_assert(sizeof(GlobalId) == sizeof(std::int64_t));

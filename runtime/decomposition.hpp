@@ -149,7 +149,6 @@ class Decomposition {
   std::string broadcast(std::string text, int root) const;
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
-  std::vector<double> allgather(std::span<const double> mine) const;
   std::vector<GlobalId> allgather(std::span<const GlobalId> mine) const;
   /// Global minimum (exact in any order).
   double min(double value) const;

@@ -86,17 +86,18 @@ Fragments FragmentLabels::label(const Topology& topo) const {
   }
   // A fragment's label is the global id of its smallest element, which one
   // rank owns: the fragments are numbered by those ids, gathered.
-  std::vector<double> mine;
+  std::vector<GlobalId> mine;
   for (Index e : owned_)
-    if (label[e] == static_cast<double>(mesh.elem_gid[e])) mine.push_back(label[e]);
-  std::vector<double> all = dec_.allgather(mine);
+    if (label[e] == static_cast<double>(mesh.elem_gid[e])) mine.push_back(mesh.elem_gid[e]);
+  std::vector<GlobalId> all = dec_.allgather(mine);
   std::sort(all.begin(), all.end());
   Fragments out;
   out.fragments = static_cast<Index>(all.size());
   out.elem_fragment.assign(ne, -1);
   for (Index e = 0; e < ne; ++e)
     if (label[e] != kNone)
-      out.elem_fragment[e] = static_cast<Index>(std::lower_bound(all.begin(), all.end(), label[e]) - all.begin());
+      out.elem_fragment[e] =
+          static_cast<Index>(std::lower_bound(all.begin(), all.end(), static_cast<GlobalId>(label[e])) - all.begin());
   return out;
 }
 
