@@ -26,14 +26,14 @@ DcrPairKind dcr_kind(const ContactPair& p) {
 
 /// The greedy coloring of the found pairs in their order, over their nodes numbered compactly
 /// (first appearance) with slot_of, a per-node scratch of -1 that is left so.
-Coloring color_found(const ContactPairs& pairs, std::span<const Index> found, std::vector<Index>& slot_of) {
+Coloring color_found(std::span<const FoundPair> found, std::vector<Index>& slot_of) {
   std::vector<Index> offsets(found.size() + 1), slots(4 * found.size());
   std::vector<Index> seen;
   Index n_slots = 0;
   for (size_t k = 0; k < found.size(); ++k) {
     offsets[k] = static_cast<Index>(4 * k);
     for (int c = 0; c < 4; ++c) {
-      const Index n = pairs[found[k]].nodes[c];
+      const Index n = found[k].pair.nodes[c];
       if (slot_of[n] < 0) {
         slot_of[n] = n_slots++;
         seen.push_back(n);
@@ -58,7 +58,7 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
   return N;
 }
 
-DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
+DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass, double dt,
                            const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
                            const DcrGather& gather, std::span<const std::uint8_t> held_masks) {
@@ -71,22 +71,20 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
   SHATTER_REQUIRE(held_masks.empty() || held_masks.size() == n_nodes,
                   "resolve_contacts: " << held_masks.size() << " held masks for " << n_nodes << " nodes");
   SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
-  for (const Index i : mine) {
-    SHATTER_REQUIRE(i >= 0 && static_cast<size_t>(i) < pairs.size(),
-                    "resolve_contacts: pair " << i << " beyond the " << pairs.size() << " pairs");
-    for (const Index n : pairs[i].nodes)
+  for (size_t i = 0; i < mine.size(); ++i)
+    for (const Index n : mine[i].nodes)
       SHATTER_REQUIRE(n >= 0 && static_cast<size_t>(n) < n_nodes, "resolve_contacts: node " << n << " of pair " << i
                                                                                             << " beyond the " << n_nodes
                                                                                             << " nodal values");
-  }
   const DcrLaw law{options.restitution, options.friction, options.gap, options.placement};
   if (scratch.moved.size() < n_nodes) scratch.moved.resize(n_nodes, 0);
   if (scratch.slot.size() < n_nodes) scratch.slot.resize(n_nodes, -1);
   // The outward normals orient the pairs at the start of the step.
-  const TriangleNormals tn = surface.surface ? triangle_normals(*surface.surface, x_old) : TriangleNormals{};
+  TriangleNormals& tn = scratch.normals;
+  if (surface.surface && !mine.empty()) triangle_normals(*surface.surface, x_old, surface.triangles, tn);
 
   DcrResult result;
-  std::vector<Index> resolved;  // every pair resolved, with repeats
+  ContactPairs resolved;  // every pair resolved, with repeats
   std::vector<double> dissipated, support_work;
   std::vector<std::uint8_t> active;
   // The first round's box test keeps the pairs of mine that may touch; later rounds check
@@ -98,11 +96,12 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
     // 2 penetrating, and in the first round 3 for a pair whose swept boxes do not overlap.
     const long previous = scratch.stamp;
     const long stamp = ++scratch.stamp;
-    const std::span<const Index> check = first_round ? mine : std::span<const Index>(kept);
-    std::vector<std::uint8_t> hit(check.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, check.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    const size_t n_check = first_round ? mine.size() : kept.size();
+    auto checked = [&](size_t k) { return first_round ? static_cast<Index>(k) : kept[k]; };
+    std::vector<std::uint8_t> hit(n_check, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n_check, 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t k = r.begin(); k != r.end(); ++k) {
-        const ContactPair& p = pairs[check[k]];
+        const ContactPair& p = mine[checked(k)];
         if (!first_round &&
             std::none_of(p.nodes.begin(), p.nodes.end(), [&](Index n) { return scratch.moved[n] == previous; }))
           continue;
@@ -119,11 +118,12 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
         hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals).penetrating ? 2 : 1;
       }
     });
-    std::vector<Index> found;
+    std::vector<FoundPair> found;
     if (first_round) kept.clear();
-    for (size_t k = 0; k < check.size(); ++k) {
-      if (hit[k] == 2) found.push_back(check[k]);
-      if (first_round && hit[k] != 3) kept.push_back(check[k]);
+    for (size_t k = 0; k < n_check; ++k) {
+      const ContactPair& p = mine[checked(k)];
+      if (hit[k] == 2) found.push_back({p, pair_normals(p, surface, tn)});
+      if (first_round && hit[k] != 3) kept.push_back(checked(k));
       result.detected += hit[k] == 1 || hit[k] == 2;
     }
     if (gather) gather(found);
@@ -132,7 +132,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
     if (found.empty()) break;
 
     // Resolution: one Gauss-Seidel pass over the found pairs, color by color.
-    const Coloring colors = color_found(pairs, found, scratch.slot);
+    const Coloring colors = color_found(found, scratch.slot);
     dissipated.assign(found.size(), 0.0);
     support_work.assign(found.size(), 0.0);
     active.assign(found.size(), 0);
@@ -141,7 +141,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
       tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k != r.end(); ++k) {
           const Index f = group[k];
-          const ContactPair& p = pairs[found[f]];
+          const ContactPair& p = found[f].pair;
           PairPoints X_old, X_new, V, W;
           PairWeights w;
           bool held = false, driven = false;  // a held component; one held at a non-zero velocity
@@ -160,7 +160,7 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
             }
           }
           const PairPoints V_before = V;
-          const PairNormals N = pair_normals(p, surface, tn);
+          const PairNormals& N = found[f].normals;
           const DcrPairResponse out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, W, law, 0.5 * dt)
                                            : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, w, law, 0.5 * dt);
           if (driven && out.active) {
@@ -185,13 +185,13 @@ DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> min
     }
     for (size_t f = 0; f < found.size(); ++f)
       if (active[f]) {
-        resolved.push_back(found[f]);
+        resolved.push_back(found[f].pair);
         result.dissipated += dissipated[f];
         result.support_work += support_work[f];
       }
     if (result.sweeps == options.max_sweeps) {
       result.capped = true;
-      result.unresolved = found.front();
+      result.unresolved = found.front().pair;
       break;
     }
   }

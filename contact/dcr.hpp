@@ -9,6 +9,7 @@
 // color, pair), so results are bitwise identical for any number of threads and ranks.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,21 +38,30 @@ struct DcrResult {
   /// dissipation), J; 0 when every held component is at rest (summed in pair order).
   double support_work = 0.0;
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
-  Index unresolved = -1;    ///< when capped: the first pair (index into the pairs) found in the last round
+  std::optional<ContactPair> unresolved;  ///< when capped: the first pair (canonical order) found in the last round
   Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds
 };
 
-/// Hands the pairs one rank found penetrating in a round to every rank: `found` (ascending
-/// indices into the pair list, this rank's) is replaced by the union over the ranks, ascending.
-/// Empty on one rank.
-using DcrGather = std::function<void(std::vector<Index>& found)>;
+/// A pair found penetrating, with the outward normals that orient it (pair_normals at x_old,
+/// computed by the rank that found it, which holds the triangles around its nodes).
+struct FoundPair {
+  ContactPair pair;
+  PairNormals normals;
+};
+
+/// Hands the pairs one rank found penetrating in a round to every rank: `found` (this rank's,
+/// in the order of its pairs) is replaced by the union over the ranks in canonical pair order,
+/// and the states x_old, x_new, v of their nodes, as the finders hold them, are written into
+/// the arrays resolve_contacts works on. Empty on one rank.
+using DcrGather = std::function<void(std::vector<FoundPair>& found)>;
 
 /// Per-node bookkeeping kept between calls, so that a call costs O(pairs), not O(mesh nodes).
 struct DcrScratch {
   std::vector<long> moved;  ///< per node: the last round stamp in which a pair moved it
   std::vector<Index> slot;  ///< per node: -1 (the coloring's compact numbering, reset after use)
   long stamp = 0;           ///< rounds started so far, over all calls
-  std::vector<Index> overlapping;  ///< out: the pairs of mine whose swept boxes overlap (last call)
+  std::vector<Index> overlapping;  ///< out: the pairs of mine (indices) whose swept boxes overlap (last call)
+  TriangleNormals normals;         ///< the triangle normals at x_old (DcrSurface::triangles of them)
 };
 
 /// The surface whose outward normals at x_old orient the pairs (kernels/dcr.hpp
@@ -59,6 +69,8 @@ struct DcrScratch {
 struct DcrSurface {
   const ContactSurface* surface = nullptr;
   const VertexTriangles* around = nullptr;
+  /// The triangles whose normals the pairs read (those around the pairs' nodes); empty: all.
+  std::span<const Index> triangles = {};
 };
 
 /// The outward normals of a pair (surface_normal, from the triangle normals tn of the
@@ -77,24 +89,24 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 ///   held      per node (empty: none), bit k set = component k held by a boundary condition:
 ///             such a node moves only in its free components (its mass counts as infinite
 ///             in the held ones: weighted() in kernels/dcr.hpp); held in all three, never.
-/// pairs is the candidate list (the same on every rank) and mine the indices of the pairs
-/// this rank checks, ascending. The work goes in rounds:
+/// mine: the candidate pairs this rank checks (on one rank, all of them), in canonical order.
+/// The work goes in rounds:
 ///   1. detection, in parallel, reading only: in the first round each pair of mine whose swept
 ///      boxes overlap (pair_boxes_overlap: the pairs a fresh search would give, kept in
 ///      scratch.overlapping) is checked by dcr_detect; in later rounds each of those with a
 ///      node moved in the previous round (the others would be found clean again);
-///   2. the pairs found penetrating on every rank (gather) are colored greedily in ascending
-///      pair order (pairs of one color share no node);
+///   2. the pairs found penetrating on every rank (gather), in canonical order, are colored
+///      greedily in that order (pairs of one color share no node);
 ///   3. resolution: one Gauss-Seidel pass over the found pairs, color after color, the pairs of
 ///      one color in parallel, each re-detected at its turn and resolved by dcr_resolve_pair.
 /// Rounds repeat until a detection finds nothing; when round options.max_sweeps still finds
 /// pairs, they are resolved and the result is capped. Every rank resolves the same pairs in
-/// the same order from the same states, so with the surface state shared beforehand the result
-/// is the same bits on every rank and for any thread count, and no state travels: only the
-/// indices of the pairs found (4 bytes each). The dissipation is summed per round in pair
-/// order. Pairs whose four nodes are not distinct are skipped. Run inside the caller's
-/// tbb::task_arena to choose the thread count.
-DcrResult resolve_contacts(const ContactPairs& pairs, std::span<const Index> mine, std::span<Vec3> x_new,
+/// the same order from the same states (the gather brings them), so the result is the same
+/// bits on every rank and for any thread count, and every rank ends with the final states of
+/// every node a pair moved. The dissipation is summed per round in pair order. Pairs whose
+/// four nodes are not distinct are skipped. Run inside the caller's tbb::task_arena to choose
+/// the thread count.
+DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass,
                            double dt, const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
                            const DcrGather& gather = {}, std::span<const std::uint8_t> held = {});

@@ -157,18 +157,24 @@ VertexTriangles vertex_triangles(const ContactSurface& surface) {
   return out;
 }
 
+void triangle_normals(const ContactSurface& surface, std::span<const Vec3> x, std::span<const Index> triangles,
+                      TriangleNormals& tn) {
+  const size_t nt = surface.triangles.size(), n = triangles.empty() ? nt : triangles.size();
+  tn.normal.resize(nt);
+  tn.length.resize(nt);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const size_t i = triangles.empty() ? k : static_cast<size_t>(triangles[k]);
+      const auto& t = surface.triangles[i];
+      tn.normal[i] = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+      tn.length[i] = tn.normal[i].norm();
+    }
+  });
+}
+
 TriangleNormals triangle_normals(const ContactSurface& surface, std::span<const Vec3> x) {
   TriangleNormals tn;
-  tn.normal.resize(surface.triangles.size());
-  tn.length.resize(surface.triangles.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 1024),
-                    [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i != r.end(); ++i) {
-                        const auto& t = surface.triangles[i];
-                        tn.normal[i] = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-                        tn.length[i] = tn.normal[i].norm();
-                      }
-                    });
+  triangle_normals(surface, x, {}, tn);
   return tn;
 }
 

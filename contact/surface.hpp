@@ -82,6 +82,10 @@ struct TriangleNormals {
   std::vector<double> length;
 };
 TriangleNormals triangle_normals(const ContactSurface& surface, std::span<const Vec3> x);
+/// The same for the listed triangles only (empty: all), into tn (sized for every triangle; the
+/// others keep what they had), so that a rank computes the normals around its own pairs only.
+void triangle_normals(const ContactSurface& surface, std::span<const Vec3> x, std::span<const Index> triangles,
+                      TriangleNormals& tn);
 
 /// Outward surface normal at a surface vertex `node` (m^2, not normalised): the sum of
 /// (x1 - x0) x (x2 - x0) over the triangles {x0, x1, x2} around it (twice the area-weighted

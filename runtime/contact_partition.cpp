@@ -20,17 +20,17 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   Zoltan_Set_Num_Obj_Fn(
       zz_, [](void* data, int* ierr) -> int {
         *ierr = ZOLTAN_OK;
-        return static_cast<int>(static_cast<ContactPartition*>(data)->count_);
+        return static_cast<int>(static_cast<ContactPartition*>(data)->ids_.size());
       },
       this);
   Zoltan_Set_Obj_List_Fn(
       zz_,
       [](void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int wdim, float* weights, int* ierr) {
         const auto* self = static_cast<ContactPartition*>(data);
-        for (Index k = 0; k < self->count_; ++k) {
-          gids[k] = static_cast<ZOLTAN_ID_TYPE>(self->first_ + k);
+        for (size_t k = 0; k < self->ids_.size(); ++k) {
+          gids[k] = static_cast<ZOLTAN_ID_TYPE>(self->ids_[k]);
           lids[k] = static_cast<ZOLTAN_ID_TYPE>(k);
-          if (wdim == 1) weights[k] = self->weights_[self->first_ + k];
+          if (wdim == 1) weights[k] = self->weights_[k];
         }
         *ierr = ZOLTAN_OK;
       },
@@ -46,7 +46,7 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
       [](void* data, int, int, int n, ZOLTAN_ID_PTR, ZOLTAN_ID_PTR lids, int dim, double* xyz, int* ierr) {
         const auto* self = static_cast<ContactPartition*>(data);
         for (int k = 0; k < n; ++k)
-          for (int c = 0; c < dim; ++c) xyz[k * dim + c] = self->points_[self->first_ + lids[k]][c];
+          for (int c = 0; c < dim; ++c) xyz[k * dim + c] = self->points_[lids[k]][c];
         *ierr = ZOLTAN_OK;
       },
       this);
@@ -54,33 +54,39 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
 
 ContactPartition::~ContactPartition() { Zoltan_Destroy(&zz_); }
 
-std::vector<int> ContactPartition::partition(std::span<const Vec3> points, std::span<const float> weights) {
-  SHATTER_REQUIRE(points.size() == weights.size(),
-                  "ContactPartition: " << points.size() << " points, " << weights.size() << " weights");
-  const auto n = static_cast<Index>(points.size());
+std::vector<int> ContactPartition::partition(std::span<const Index> ids, std::span<const Vec3> points,
+                                             std::span<const float> weights, Index total) {
+  SHATTER_REQUIRE(ids.size() == points.size() && points.size() == weights.size(),
+                  "ContactPartition: " << ids.size() << " ids, " << points.size() << " points, " << weights.size()
+                                       << " weights");
+  ids_ = ids;
   points_ = points;
   weights_ = weights;
-  first_ = static_cast<Index>(static_cast<long>(n) * rank_ / size_);
-  count_ = static_cast<Index>(static_cast<long>(n) * (rank_ + 1) / size_) - first_;
   int changes = 0, gid_entries = 0, lid_entries = 0, n_import = 0, n_export = 0;
   ZOLTAN_ID_PTR import_gids = nullptr, import_lids = nullptr, export_gids = nullptr, export_lids = nullptr;
   int *import_procs = nullptr, *import_parts = nullptr, *export_procs = nullptr, *export_parts = nullptr;
   const int rc = Zoltan_LB_Partition(zz_, &changes, &gid_entries, &lid_entries, &n_import, &import_gids, &import_lids,
                                      &import_procs, &import_parts, &n_export, &export_gids, &export_lids,
                                      &export_procs, &export_parts);
-  std::vector<int> mine(count_, rank_);
+  // Pairs (id, part) of the objects listed here.
+  std::vector<int> mine(2 * ids.size());
+  for (size_t k = 0; k < ids.size(); ++k) mine[2 * k] = ids[k], mine[2 * k + 1] = rank_;
   if (rc == ZOLTAN_OK)
-    for (int k = 0; k < n_export; ++k) mine[export_lids[k]] = export_parts[k];
+    for (int k = 0; k < n_export; ++k) mine[2 * export_lids[k] + 1] = export_parts[k];
   Zoltan_LB_Free_Part(&import_gids, &import_lids, &import_procs, &import_parts);
   Zoltan_LB_Free_Part(&export_gids, &export_lids, &export_procs, &export_parts);
   // Every rank gets the same return code: Zoltan's calls are collective.
   SHATTER_REQUIRE(rc == ZOLTAN_OK, "Zoltan_LB_Partition (RCB) failed with code " << rc);
   std::vector<int> counts(size_), displs(size_, 0);
-  for (int r = 0; r < size_; ++r)
-    counts[r] = static_cast<int>(static_cast<long>(n) * (r + 1) / size_ - static_cast<long>(n) * r / size_);
+  const int n = static_cast<int>(mine.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   for (int r = 1; r < size_; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<int> parts(n);
-  MPI_Allgatherv(mine.data(), count_, MPI_INT, parts.data(), counts.data(), displs.data(), MPI_INT, comm_);
+  std::vector<int> all(displs[size_ - 1] + counts[size_ - 1]);
+  MPI_Allgatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, comm_);
+  SHATTER_REQUIRE(all.size() == 2 * static_cast<size_t>(total),
+                  "ContactPartition: " << all.size() / 2 << " objects listed for " << total);
+  std::vector<int> parts(total, -1);
+  for (size_t k = 0; k < all.size(); k += 2) parts[all[k]] = all[k + 1];
   return parts;
 }
 

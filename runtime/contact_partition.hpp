@@ -1,10 +1,9 @@
 #pragma once
 // Recursive coordinate bisection of the contact surface over the MPI ranks
 // (Zoltan, LB_METHOD RCB; docs/parallel.md "Contact across ranks"): which
-// rank resolves the pairs of each surface primitive. The partition is a
-// function of the primitives' points and weights only (every rank passes the
-// same ones and gets the same parts), and the results of the contact stage do
-// not depend on it: it decides the load balance, never the bits.
+// rank searches and detects the pairs of each surface primitive. Each rank
+// hands Zoltan the primitives it holds now; the results of the contact stage
+// do not depend on the partition: it decides the load balance, never the bits.
 #include <mpi.h>
 
 #include <span>
@@ -24,20 +23,21 @@ class ContactPartition {
   ContactPartition(const ContactPartition&) = delete;
   ContactPartition& operator=(const ContactPartition&) = delete;
 
-  /// The part (rank) of each of the points, weighted by weights (>= 0), the same
-  /// array on every rank (collective: every rank passes the same points and weights).
-  /// Each rank hands Zoltan the points [k n / R, (k+1) n / R); the parts come back
+  /// The part (rank) of each of `total` objects, the same array on every rank
+  /// (collective). Each rank passes the objects it holds (ids in [0, total), each id
+  /// on exactly one rank) with their points and weights (>= 0); the parts come back
   /// through one MPI_Allgatherv.
-  std::vector<int> partition(std::span<const Vec3> points, std::span<const float> weights);
+  std::vector<int> partition(std::span<const Index> ids, std::span<const Vec3> points,
+                             std::span<const float> weights, Index total);
 
  private:
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   Zoltan_Struct* zz_ = nullptr;
   // The slice handed to Zoltan's callbacks during partition().
+  std::span<const Index> ids_;
   std::span<const Vec3> points_;
   std::span<const float> weights_;
-  Index first_ = 0, count_ = 0;
 };
 
 }  // namespace shatter

@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_reduce.h>
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <numeric>
@@ -9,10 +11,22 @@
 #include "contact/candidates.hpp"
 #include "kernels/error.hpp"
 #include "runtime/contact_partition.hpp"
+#include "runtime/contact_patch.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/parallel.hpp"
 
 namespace shatter {
+
+namespace {
+
+/// This thread's CPU time, s.
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
 
 ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const Decomposition* dec) {
   if (dec && dec->distributed()) {
@@ -42,12 +56,15 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
     margin_ = margin_fraction_ * lengths[lengths.size() / 2];
   }
   have_candidates_ = false;
+  pairs_.clear();
   if (!dec_) return;
   triangle_order_.resize(surface_.triangles.size());
   std::iota(triangle_order_.begin(), triangle_order_.end(), 0);
   std::sort(triangle_order_.begin(), triangle_order_.end(), [&](Index a, Index b) {
     return std::pair(surface_.triangles[a], a) < std::pair(surface_.triangles[b], b);
   });
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, mesh.num_nodes());
+  weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
 
@@ -55,8 +72,9 @@ ContactStage::~ContactStage() = default;
 
 bool ContactStage::candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const {
   if (!have_candidates_) return false;
-  const auto& vertices = surface_.vertices;
-  return tbb::parallel_reduce(
+  // On several ranks each checks its patch's vertices (every primitive's nodes are in its owner's).
+  const auto& vertices = dec_ ? patch_->patch().vertices : surface_.vertices;
+  const bool valid = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, vertices.size(), 4096), true,
       [&](const tbb::blocked_range<size_t>& r, bool valid) {
         for (size_t k = r.begin(); k < r.end() && valid; ++k) {
@@ -67,90 +85,120 @@ bool ContactStage::candidates_valid(std::span<const Vec3> x_old, std::span<const
         return valid;
       },
       [](bool a, bool b) { return a && b; });
+  return dec_ ? dec_->max(valid ? 0 : 1) == 0 : valid;
 }
 
-void ContactStage::search(std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
-  SweptBoxes boxes = swept_boxes(surface_, x_old, x_new);
-  for (auto* list : {&boxes.triangles, &boxes.edges, &boxes.vertices})
-    for (Box& b : *list) {
-      b.lo.array() -= 1.01 * margin_;
-      b.hi.array() += 1.01 * margin_;
-    }
-  pairs_ = find_candidates(surface_, boxes);
+void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
+  if (dec_) {
+    search_patch(x_old, x_new, v);
+  } else {
+    const double cpu0 = cpu_seconds();
+    pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_));
+    profile_.search_cpu_seconds += cpu_seconds() - cpu0;
+  }
   x_search_.assign(x_new.begin(), x_new.end());
   have_candidates_ = true;
   ++profile_.searches;
-  if (dec_) {
-    assign_pairs(x_new);
-  } else {
-    mine_.resize(pairs_.size());
-    std::iota(mine_.begin(), mine_.end(), 0);
-  }
+}
+
+void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
+  const auto t0 = std::chrono::steady_clock::now();
+  patch_->exchange(x_old, x_new, v);
+  profile_.exchange_bytes += patch_->exchange_bytes();
+  profile_.state_bytes += patch_->exchange_bytes();
+  profile_.exchange_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Ownership rule: a candidate belongs to the rank of its face (vertex-face) or of
 // its first edge (edge-edge). A primitive's weight is its number of candidates
 // (the filter's work, and a bound on DCR's), plus 1 % so that RCB also spreads
-// the surface away from the contact. The primitives are re-partitioned at a
-// search (i.e. when the surface moved past the reuse margin) if the surface was
-// rebuilt or the candidates per rank under the current partition are out of
-// balance by more than 10 % (largest over mean).
-void ContactStage::assign_pairs(std::span<const Vec3> x) {
+// the surface away from the contact. Before the first partition a primitive
+// belongs to the volume owner of its first node. The primitives are
+// re-partitioned at a search (i.e. when the surface moved past the reuse margin)
+// if the surface was rebuilt, or if the candidates per rank are out of balance by
+// more than 10 % (largest over mean), and then searched again.
+void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
   const auto nt = static_cast<Index>(surface_.triangles.size());
-  std::vector<Index> primitive(pairs_.size());
-  parallel_for_each(static_cast<Index>(pairs_.size()), [&](Index k) {
-    const ContactPair& p = pairs_[k];
-    if (p.kind == ContactPair::VertexFace) {
-      const std::array<Index, 3> face{p.nodes[1], p.nodes[2], p.nodes[3]};
-      const auto it = std::lower_bound(triangle_order_.begin(), triangle_order_.end(), face,
-                                       [&](Index t, const std::array<Index, 3>& f) { return surface_.triangles[t] < f; });
-      SHATTER_ASSERT(it != triangle_order_.end() && surface_.triangles[*it] == face);
-      primitive[k] = *it;
-    } else {
-      const std::array<Index, 2> edge{p.nodes[0], p.nodes[1]};
-      const auto it = std::lower_bound(surface_.edges.begin(), surface_.edges.end(), edge);
-      SHATTER_ASSERT(it != surface_.edges.end() && *it == edge);
-      primitive[k] = nt + static_cast<Index>(it - surface_.edges.begin());
+  if (!patch_->owned_any()) {
+    std::vector<int> first_owner(surface_.triangles.size() + surface_.edges.size());
+    for (size_t q = 0; q < first_owner.size(); ++q)
+      first_owner[q] = dec_->node_owner(static_cast<Index>(q) < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]);
+    patch_->own(std::move(first_owner));
+    exchange(x_old, x_new, v);
+  }
+  for (bool repartitioned = false;; repartitioned = true) {
+    if (repartition_) {
+      patch_->own(partition(x_new));
+      exchange(x_old, x_new, v);
+      repartition_ = false;
+      ++profile_.repartitions;
     }
-  });
-  const int ranks = dec_->size();
-  bool balanced = !repartition_;
-  if (balanced) {
-    std::vector<long> per_rank(ranks, 0);
-    for (const Index q : primitive) ++per_rank[primitive_rank_[q]];
-    const long most = *std::max_element(per_rank.begin(), per_rank.end());
-    balanced = most * ranks <= 1.1 * static_cast<double>(pairs_.size());
-  }
-  if (!balanced) {
-    const size_t n = surface_.triangles.size() + surface_.edges.size();
-    std::vector<float> weight(n, 0.01f);
-    for (const Index q : primitive) weight[q] += 1.0f;
-    std::vector<Vec3> point(n);
-    parallel_for_each(static_cast<Index>(n), [&](Index q) {
-      if (q < nt) {
-        const auto& t = surface_.triangles[q];
-        point[q] = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
+    patch_->reach(x_old, x_new, margin_);
+    exchange(x_old, x_new, v);
+    const double cpu0 = cpu_seconds();
+    const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_));
+    // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
+    pairs_.clear();
+    std::fill(weight_.begin(), weight_.end(), 0.0f);
+    const std::vector<int>& rank = patch_->primitive_rank();
+    for (const ContactPair& p : found) {
+      Index q;
+      if (p.kind == ContactPair::VertexFace) {
+        const std::array<Index, 3> face{p.nodes[1], p.nodes[2], p.nodes[3]};
+        const auto it = std::lower_bound(triangle_order_.begin(), triangle_order_.end(), face,
+                                         [&](Index t, const std::array<Index, 3>& f) { return surface_.triangles[t] < f; });
+        SHATTER_ASSERT(it != triangle_order_.end() && surface_.triangles[*it] == face);
+        q = *it;
       } else {
-        const auto& e = surface_.edges[q - nt];
-        point[q] = 0.5 * (x[e[0]] + x[e[1]]);
+        const std::array<Index, 2> edge{p.nodes[0], p.nodes[1]};
+        const auto it = std::lower_bound(surface_.edges.begin(), surface_.edges.end(), edge);
+        SHATTER_ASSERT(it != surface_.edges.end() && *it == edge);
+        q = nt + static_cast<Index>(it - surface_.edges.begin());
       }
-    });
-    primitive_rank_ = partition_->partition(point, weight);
-    repartition_ = false;
-    ++profile_.repartitions;
+      if (rank[q] != dec_->rank()) continue;
+      pairs_.push_back(p);
+      weight_[q] += 1.0f;
+    }
+    profile_.search_cpu_seconds += cpu_seconds() - cpu0;
+    const long mine = static_cast<long>(pairs_.size());
+    const long most = dec_->max(mine), total = dec_->sum(std::vector<long>{mine})[0];
+    if (repartitioned || most * dec_->size() <= 1.1 * static_cast<double>(total)) break;
+    repartition_ = true;
   }
-  mine_.clear();
-  for (size_t k = 0; k < pairs_.size(); ++k)
-    if (primitive_rank_[primitive[k]] == dec_->rank()) mine_.push_back(static_cast<Index>(k));
 }
 
-std::array<long, 3> ContactStage::owned_pairs_range() const {
-  long v[2] = {-profile_.owned_pairs, profile_.owned_pairs}, sum = profile_.owned_pairs;
-  if (dec_) {
-    MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_LONG, MPI_MAX, dec_->comm());
-    MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_LONG, MPI_SUM, dec_->comm());
+std::vector<int> ContactStage::partition(std::span<const Vec3> x) {
+  const auto nt = static_cast<Index>(surface_.triangles.size());
+  std::vector<Index> ids;
+  std::vector<Vec3> points;
+  std::vector<float> weights;
+  for (const Index t : patch_->owned_triangles()) {
+    const auto& n = surface_.triangles[t];
+    ids.push_back(t);
+    points.push_back((x[n[0]] + x[n[1]] + x[n[2]]) / 3.0);
   }
-  return {-v[0], v[1], sum};
+  for (const Index e : patch_->owned_edges()) {
+    const auto& n = surface_.edges[e];
+    ids.push_back(nt + e);
+    points.push_back(0.5 * (x[n[0]] + x[n[1]]));
+  }
+  for (const Index q : ids) weights.push_back(0.01f + weight_[q]);
+  return partition_->partition(ids, points, weights, static_cast<Index>(weight_.size()));
+}
+
+ContactBalance ContactStage::balance() const {
+  const ContactProfile& p = profile_;
+  ContactBalance b{p.owned_pairs, p.owned_pairs, p.owned_pairs, p.candidates, p.state_bytes, p.found_bytes,
+                   p.search_cpu_seconds, p.sweep_cpu_seconds};
+  if (dec_) {
+    long most[4] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max}, sum[2] = {b.pairs_sum, b.candidates_sum};
+    double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
+    MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_LONG, MPI_MAX, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPI_LONG, MPI_SUM, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
+    b = {-most[0], most[1], sum[0], sum[1], most[2], most[3], cpu[0], cpu[1]};
+  }
+  return b;
 }
 
 ContactPairs ContactStage::active_pairs() const {
@@ -160,7 +208,7 @@ ContactPairs ContactStage::active_pairs() const {
   return out;
 }
 
-DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
+DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                               std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held) {
   using clock = std::chrono::steady_clock;
   // Each phase's wall time, less the exchanges within it (counted apart).
@@ -170,22 +218,31 @@ DcrResult ContactStage::apply(std::span<const Vec3> x_old, std::span<Vec3> x_new
     last = now;
     exchanged = profile_.exchange_seconds;
   };
+  if (dec_) exchange(x_old, x_new, v);
   const bool valid = candidates_valid(x_old, x_new);
   lap(profile_.verlet_seconds);
-  if (!valid) search(x_old, x_new);
+  if (!valid) search(x_old, x_new, v);
   lap(profile_.search_seconds);
   DcrGather gather;
-  if (dec_)
-    gather = [&](std::vector<Index>& found) {
+  DcrSurface surface{&surface_, &vertex_triangles_};
+  const double cpu0 = cpu_seconds();
+  double gather_cpu = 0;
+  if (dec_) {
+    surface.triangles = patch_->normal_triangles();
+    gather = [&](std::vector<FoundPair>& found) {
+      const double gather0 = cpu_seconds();
       const auto t0 = clock::now();
-      profile_.exchange_bytes += static_cast<long>(sizeof(Index) * found.size() * (dec_->size() - 1));
-      found = dec_->allgather(found);
-      std::sort(found.begin(), found.end());
+      const long bytes = patch_->share_found(found, x_old, x_new, v);
+      profile_.exchange_bytes += bytes;
+      profile_.found_bytes += bytes;
       profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+      gather_cpu += cpu_seconds() - gather0;
     };
-  const DcrResult r = resolve_contacts(pairs_, mine_, x_new, x_old, v, inv_mass, dt, options_,
-                                       {&surface_, &vertex_triangles_}, scratch_, gather, held);
+  }
+  const DcrResult r =
+      resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, gather, held);
   lap(profile_.sweep_seconds);
+  profile_.sweep_cpu_seconds += cpu_seconds() - cpu0 - gather_cpu;
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());
   profile_.owned_pairs += static_cast<long>(scratch_.overlapping.size());

@@ -14,14 +14,16 @@
 // the pairs a fresh search would: DCR sees the same list, in the same order,
 // whatever the reuse schedule (restarts stay bitwise).
 //
-// On several MPI ranks (docs/parallel.md "Contact across ranks") every rank
-// holds the surface state (the caller shares it) and runs the search; the
-// surface primitives are partitioned by RCB (ContactPartition) and a pair
-// belongs to the rank of its face (vertex-face) or first edge (edge-edge).
-// Each rank filters and detects its own candidates; the few pairs found
-// penetrating are gathered, and every rank resolves all of them in the same
-// order (resolve_contacts): every rank ends with the serial bits of every
-// surface node, and only pair indices travel.
+// On several MPI ranks (docs/parallel.md "Contact across ranks") the surface
+// primitives are partitioned by RCB (ContactPartition) and each rank holds a
+// patch of the surface (ContactPatch): its own primitives, the ghosts whose
+// boxes reach them, and the states of their nodes, which the volume owners
+// send point to point each step. A pair belongs to the rank of its face
+// (vertex-face) or first edge (edge-edge); each rank searches and detects its
+// patch only. The few pairs found penetrating travel to every rank with the
+// states of their nodes, and every rank resolves all of them in the same order
+// (resolve_contacts): every rank ends with the serial bits of every node a pair
+// moved.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -46,13 +48,27 @@ struct ContactProfile {
   long detections = 0;   ///< pair detections run here, summed over steps
   long sweeps = 0;       ///< detection rounds, summed over steps
   // On several ranks:
-  long exchange_bytes = 0;      ///< bytes this rank sent: the pairs it found penetrating
+  long exchange_bytes = 0;      ///< bytes this rank sent: state_bytes + found_bytes
+  long state_bytes = 0;         ///< its nodes' states to the patches that hold them
+  long found_bytes = 0;         ///< the pairs it found penetrating, with their nodes' states
   double exchange_seconds = 0;  ///< in those gathers (not in the times above)
   long repartitions = 0;        ///< RCB partitions computed
+  // Thread CPU time of the work itself (meaningful when ranks share cores):
+  double search_cpu_seconds = 0;  ///< the searches' boxes, bucket search and filter
+  double sweep_cpu_seconds = 0;   ///< DCR, less the gathers
+};
+
+/// ContactProfile over the ranks (ContactStage::balance, summary.json).
+struct ContactBalance {
+  long pairs_min = 0, pairs_max = 0, pairs_sum = 0;  ///< ContactProfile::owned_pairs
+  long candidates_sum = 0;
+  long state_bytes_max = 0, found_bytes_max = 0;
+  double search_cpu_max = 0, sweep_cpu_max = 0;
 };
 
 class Decomposition;
 class ContactPartition;
+class ContactPatch;
 
 class ContactStage {
  public:
@@ -64,7 +80,10 @@ class ContactStage {
   /// them: x_new is projected back, v (the mid-step velocity) gets the DCR
   /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move;
   /// held (empty: none): per node, bit k = component k held (resolve_contacts).
-  DcrResult apply(std::span<const Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
+  /// On several ranks the arrays' owned entries are the state; the patch's other
+  /// nodes (x_old too) are filled from their owners, and every node a pair moved
+  /// gets its final state on every rank.
+  DcrResult apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                   std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {});
 
   /// Rebuild the surface after fracture split nodes: crack faces whose sides
@@ -72,8 +91,7 @@ class ContactStage {
   void rebuild(const Mesh& mesh);
 
   const ContactSurface& surface() const { return surface_; }
-  /// The candidates of the search in force (the same on every rank; DcrResult::unresolved
-  /// indexes them).
+  /// The candidates of the search in force (on several ranks, this rank's).
   const ContactPairs& candidates() const { return pairs_; }
   /// This rank's pairs that DCR checked in the last apply(): on one rank, equal to the
   /// pairs of a fresh search whose swept boxes overlap.
@@ -84,8 +102,8 @@ class ContactStage {
   double dcr_seconds() const { return profile_.sweep_seconds; }
   long searches() const { return profile_.searches; }
   const ContactProfile& profile() const { return profile_; }
-  /// Smallest, largest and sum of profile().owned_pairs over the ranks (collective).
-  std::array<long, 3> owned_pairs_range() const;
+  /// profile() over the ranks (collective).
+  ContactBalance balance() const;
   /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
   /// median surface edge length.
   double margin() const { return margin_; }
@@ -95,9 +113,14 @@ class ContactStage {
   /// margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
-  void search(std::span<const Vec3> x_old, std::span<const Vec3> x_new);
-  /// This rank's new candidates (mine_); a new RCB partition when needed (the rule in contact_stage.cpp).
-  void assign_pairs(std::span<const Vec3> x);
+  void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
+  /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
+  /// in contact_stage.cpp).
+  void search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
+  /// The RCB partition of the owned primitives at x, weighted by their candidates.
+  std::vector<int> partition(std::span<const Vec3> x);
+  /// The patch's nodes' states from their owners (timed and counted as exchange).
+  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
 
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
@@ -105,17 +128,17 @@ class ContactStage {
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
   bool have_candidates_ = false;
-  ContactPairs pairs_;          ///< candidates of the last search (inflated boxes)
-  std::vector<Index> mine_;     ///< this rank's candidates (indices into pairs_, ascending)
+  ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;
   // Several ranks:
   const Decomposition* dec_ = nullptr;  ///< null on one rank
   std::unique_ptr<ContactPartition> partition_;
-  std::vector<Index> triangle_order_;  ///< triangles sorted by their nodes (pair -> face)
-  std::vector<int> primitive_rank_;    ///< rank of each triangle, then of each edge
-  bool repartition_ = true;            ///< the surface changed: partition at the next search
+  std::unique_ptr<ContactPatch> patch_;  ///< of surface_
+  std::vector<Index> triangle_order_;    ///< triangles sorted by their nodes (pair -> face)
+  std::vector<float> weight_;            ///< per triangle, then edge: candidates at the last search (owned ones)
+  bool repartition_ = true;              ///< partition at the next search
 };
 
 }  // namespace shatter

@@ -14,30 +14,6 @@
 namespace shatter {
 namespace {
 
-/// This rank's values of the plan's nodes it owns, interleaved: node-major, then array, then component.
-std::vector<double> pack(const SharedNodes& plan, int rank, std::span<const std::span<Vec3>> arrays) {
-  const size_t m = 3 * arrays.size(), first = plan.displacements[rank];
-  std::vector<double> out(plan.counts[rank] * m);
-  for (size_t i = 0; i < static_cast<size_t>(plan.counts[rank]); ++i)
-    for (size_t a = 0; a < arrays.size(); ++a)
-      for (int c = 0; c < 3; ++c) out[i * m + 3 * a + c] = arrays[a][plan.by_rank[first + i]][c];
-  return out;
-}
-
-void unpack(const SharedNodes& plan, std::span<const double> in, std::span<const std::span<Vec3>> arrays) {
-  const size_t m = 3 * arrays.size();
-  for (size_t i = 0; i < plan.by_rank.size(); ++i)
-    for (size_t a = 0; a < arrays.size(); ++a)
-      for (int c = 0; c < 3; ++c) arrays[a][plan.by_rank[i]][c] = in[i * m + 3 * a + c];
-}
-
-/// Counts and displacements of the plan in doubles, for m doubles per node.
-std::pair<std::vector<int>, std::vector<int>> layout(const SharedNodes& plan, int m) {
-  std::pair<std::vector<int>, std::vector<int>> l{plan.counts, plan.displacements};
-  for (size_t r = 0; r < plan.counts.size(); ++r) l.first[r] *= m, l.second[r] *= m;
-  return l;
-}
-
 }  // namespace
 
 Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) {
@@ -223,31 +199,6 @@ DecompositionStats Decomposition::stats() const {
   return {-v[0], v[1], v[2], v[3], v[4]};
 }
 
-SharedNodes Decomposition::shared_nodes(std::vector<Index> nodes) const {
-  SharedNodes s;
-  s.nodes = std::move(nodes);
-  s.counts.assign(size_, 0);
-  s.displacements.assign(size_, 0);
-  if (size_ == 1) return s;
-  for (Index n : s.nodes) ++s.counts[node_owner(n)];
-  for (int r = 1; r < size_; ++r) s.displacements[r] = s.displacements[r - 1] + s.counts[r - 1];
-  s.by_rank.resize(s.nodes.size());
-  std::vector<int> fill = s.displacements;
-  for (Index n : s.nodes) s.by_rank[fill[node_owner(n)]++] = n;
-  return s;
-}
-
-void Decomposition::share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) const {
-  if (size_ == 1) return;
-  const int m = 3 * static_cast<int>(arrays.size());
-  const std::vector<double> out = pack(plan, rank_, arrays);
-  std::vector<double> in(plan.by_rank.size() * m);
-  const auto [counts, displs] = layout(plan, m);
-  MPI_Allgatherv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, in.data(), counts.data(), displs.data(),
-                 MPI_DOUBLE, comm_);
-  unpack(plan, in, arrays);
-}
-
 std::vector<std::vector<Vec3>> Decomposition::gather_to_root(std::span<const std::span<const Vec3>> arrays) const {
   const size_t m = arrays.size();
   if (size_ == 1) {
@@ -313,6 +264,32 @@ std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   static_assert(sizeof(Index) == sizeof(int));
   return allgather_of(mine, MPI_INT, comm_, size_);
+}
+
+std::vector<double> Decomposition::allgather(std::span<const double> mine) const {
+  if (size_ == 1) return {mine.begin(), mine.end()};
+  return allgather_of(mine, MPI_DOUBLE, comm_, size_);
+}
+
+std::vector<std::vector<Index>> Decomposition::alltoall(const std::vector<std::vector<Index>>& to) const {
+  SHATTER_REQUIRE(static_cast<int>(to.size()) == size_, "alltoall: " << to.size() << " lists for " << size_ << " ranks");
+  if (size_ == 1) return to;
+  std::vector<int> send_counts(size_), recv_counts(size_), send_at(size_, 0), recv_at(size_, 0);
+  for (int r = 0; r < size_; ++r) send_counts[r] = static_cast<int>(to[r].size());
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
+  for (int r = 1; r < size_; ++r) {
+    send_at[r] = send_at[r - 1] + send_counts[r - 1];
+    recv_at[r] = recv_at[r - 1] + recv_counts[r - 1];
+  }
+  std::vector<Index> out, in(recv_at[size_ - 1] + recv_counts[size_ - 1]);
+  out.reserve(send_at[size_ - 1] + send_counts[size_ - 1]);
+  for (const auto& list : to) out.insert(out.end(), list.begin(), list.end());
+  static_assert(sizeof(Index) == sizeof(int));
+  MPI_Alltoallv(out.data(), send_counts.data(), send_at.data(), MPI_INT, in.data(), recv_counts.data(),
+                recv_at.data(), MPI_INT, comm_);
+  std::vector<std::vector<Index>> from(size_);
+  for (int r = 0; r < size_; ++r) from[r].assign(in.begin() + recv_at[r], in.begin() + recv_at[r] + recv_counts[r]);
+  return from;
 }
 
 std::vector<GlobalId> Decomposition::allgather(std::span<const GlobalId> mine) const {

@@ -51,14 +51,6 @@ struct DecompositionStats {
   long ghost_messages_max = 0;        ///< messages one rank sends per ghost update
 };
 
-/// A subset of the nodes, listed identically on every rank (ascending), whose
-/// owners' values are shared with every rank (Decomposition::share).
-struct SharedNodes {
-  std::vector<Index> nodes;                 ///< the subset, ascending
-  std::vector<Index> by_rank;               ///< the subset grouped by owner rank, ascending within
-  std::vector<int> counts, displacements;   ///< per rank: nodes it owns in the subset, offsets in by_rank
-};
-
 class Decomposition {
  public:
   /// Partitions `model`'s elements over the ranks of `comm` (every rank
@@ -130,10 +122,6 @@ class Decomposition {
   /// Over all ranks (collective).
   DecompositionStats stats() const;
 
-  /// The plan of share() for `nodes` (ascending, the same on every rank).
-  SharedNodes shared_nodes(std::vector<Index> nodes) const;
-  /// After the call every rank holds the owners' values of the plan's nodes in `arrays`.
-  void share(const SharedNodes& plan, std::span<const std::span<Vec3>> arrays) const;
   /// The owners' values of every node of the whole model, in its node order,
   /// on rank 0 (empty arrays elsewhere; collective).
   std::vector<std::vector<Vec3>> gather_to_root(std::span<const std::span<const Vec3>> arrays) const;
@@ -150,6 +138,10 @@ class Decomposition {
   /// Every rank's `mine`, concatenated in rank order, on every rank.
   std::vector<Index> allgather(std::span<const Index> mine) const;
   std::vector<GlobalId> allgather(std::span<const GlobalId> mine) const;
+  std::vector<double> allgather(std::span<const double> mine) const;
+  /// Sparse all-to-all: to[r] goes to rank r (to.size() == size()); returns what each rank sent here
+  /// (MPI_Alltoall of the counts, MPI_Alltoallv of the ids; collective).
+  std::vector<std::vector<Index>> alltoall(const std::vector<std::vector<Index>>& to) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
   /// In place: the element-wise global minima.

@@ -7,13 +7,13 @@
 
 namespace shatter {
 
-std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const ContactPairs& pairs,
-                                const DcrResult& r, long step, double time) {
+std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const DcrResult& r, long step,
+                                double time) {
   std::ostringstream os;
   os << "step " << step << ", t = " << time << " s: DCR sweeps reached the cap (contact.max_sweeps = "
      << model.scene.contact->max_sweeps << ") with penetrations left (contact.on_sweep_cap: fail)";
-  if (r.unresolved >= 0 && static_cast<size_t>(r.unresolved) < pairs.size()) {
-    const ContactPair& p = pairs[r.unresolved];
+  if (r.unresolved) {
+    const ContactPair& p = *r.unresolved;
     Vec3 centre = Vec3::Zero();
     os << "; still penetrating: " << (p.kind == ContactPair::VertexFace ? "vertex-face" : "edge-edge")
        << " pair of nodes";

@@ -13,8 +13,8 @@ namespace shatter {
 
 /// A step whose DCR sweeps reached the cap, when the scene says
 /// contact.on_sweep_cap: fail. `step` is the step under way.
-std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const ContactPairs& pairs,
-                                const DcrResult& r, long step, double time);
+std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const DcrResult& r, long step,
+                                double time);
 
 /// The stable step of a step's configuration and the element that sets it
 /// (Simulation::check_step_collapse).

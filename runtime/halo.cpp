@@ -44,9 +44,14 @@ void Halo::begin_update(std::span<const double> values, int components) {
   check(values, components, false);
   const size_t c = components;
   send_buffer_.resize(send_.nodes.size() * c);
-  recv_buffer_.resize(recv_.nodes.size() * c);
   for (size_t p = 0; p < send_.nodes.size(); ++p)
     std::copy_n(values.data() + send_.nodes[p] * c, c, send_buffer_.data() + p * c);
+  post(components);
+}
+
+void Halo::post(int components) {
+  const size_t c = components;
+  recv_buffer_.resize(recv_.nodes.size() * c);
   requests_.resize(send_.ranks.size() + recv_.ranks.size());
   for (int i = 0; i < recv_.num_ranks(); ++i)
     MPI_Irecv(recv_buffer_.data() + recv_.offsets[i] * c,
@@ -82,6 +87,18 @@ void Halo::end_update(std::span<Vec3> values) {
 
 void Halo::update_ghosts(std::span<Vec3> values) {
   update_ghosts(as_doubles(values), 3);
+}
+
+void Halo::update_ghosts(std::span<const std::span<Vec3>> arrays) {
+  for (const auto& a : arrays) check(as_doubles(a), 3, false);
+  const size_t c = 3 * arrays.size();
+  send_buffer_.resize(send_.nodes.size() * c);
+  for (size_t p = 0; p < send_.nodes.size(); ++p)
+    for (size_t k = 0; k < arrays.size(); ++k) std::copy_n(arrays[k][send_.nodes[p]].data(), 3, &send_buffer_[p * c + 3 * k]);
+  post(static_cast<int>(c));
+  wait();
+  for (size_t p = 0; p < recv_.nodes.size(); ++p)
+    for (size_t k = 0; k < arrays.size(); ++k) std::copy_n(&recv_buffer_[p * c + 3 * k], 3, arrays[k][recv_.nodes[p]].data());
 }
 
 }  // namespace shatter

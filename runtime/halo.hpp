@@ -50,6 +50,8 @@ class Halo {
   /// begin_update + end_update.
   void update_ghosts(std::span<double> values, int components);
   void update_ghosts(std::span<Vec3> values);
+  /// update_ghosts of several arrays in one message per rank.
+  void update_ghosts(std::span<const std::span<Vec3>> arrays);
 
   /// Bytes this rank sends per update of `components` doubles per node.
   std::size_t update_bytes(int components) const { return send_.nodes.size() * components * sizeof(double); }
@@ -59,6 +61,8 @@ class Halo {
  private:
   void check(std::span<const double> values, int components, bool expect_pending) const;
   void wait();
+  /// Post the receives and the sends of send_buffer_, `components` doubles per node.
+  void post(int components);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   Index num_nodes_ = 0;

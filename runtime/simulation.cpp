@@ -229,11 +229,7 @@ void Simulation::predict() {
 }
 
 void Simulation::resolve_contact() {
-  // Every rank resolves the whole contact surface from the owners' states.
-  if (surface_nodes_) {
-    const std::span<Vec3> arrays[] = {x_prev_, x_, v_};
-    timed(comm_seconds_, [&] { dec_->share(*surface_nodes_, arrays); });
-  }
+  // On several ranks the contact stage brings its patch's states from their owners.
   const std::vector<Index>& vertices = contact_->surface().vertices;
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
@@ -248,7 +244,7 @@ void Simulation::resolve_contact() {
   ledger_.external_work += r.support_work;
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
-      throw Error(sweep_cap_diagnosis(model_, x_, contact_->candidates(), r, step_ + 1, time_ + dt_));
+      throw Error(sweep_cap_diagnosis(model_, x_, r, step_ + 1, time_ + dt_));
     if (ledger_.contact_capped_steps == 0 && dec_->rank() == 0)
       std::fprintf(stderr,
                    "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
@@ -303,11 +299,10 @@ void Simulation::apply_fracture() {
   const Insertion ins = fracture_->insert(critical);
   ledger_.cohesive_elements = fracture_->cohesive_count();
   if (ledger_.cohesive_elements == before) return;
-  if (!ins.new_nodes.empty()) {
-    grow_nodes(ins.new_nodes);
-    if (contact_) contact_->rebuild(model_.mesh);
-  }
+  if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
   dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
+  // After the node lists: the contact patch asks who owns the new nodes.
+  if (contact_ && !ins.new_nodes.empty()) contact_->rebuild(model_.mesh);
   share_plans();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
@@ -319,7 +314,6 @@ void Simulation::share_plans() {
   if (fracture_) fracture_->share();
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
-  if (contact_) surface_nodes_ = std::make_unique<SharedNodes>(dec_->shared_nodes(contact_->surface().vertices));
 }
 
 void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {

@@ -39,8 +39,8 @@ class CsvWriter;
 class ContactStage;
 class SurfaceLoads;
 class Decomposition;
-struct SharedNodes;
 struct DecompositionStats;
+struct ContactBalance;
 
 struct RunOptions {
   std::filesystem::path out_dir;  ///< empty: write no files (tests)
@@ -167,7 +167,7 @@ class Simulation {
   void write_outputs(bool fields);
   /// `crack`: the crack surface at the end (fracture only; write_fragments).
   /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
-  void write_summary(double wall_seconds, const DecompositionStats& stats, std::array<long, 3> contact_pairs_range,
+  void write_summary(double wall_seconds, const DecompositionStats& stats, const ContactBalance& contact_balance,
                      const CrackArea& crack, const std::pair<std::vector<long>, long>& memory);
   /// Bytes of the arrays this rank holds in the loop: the model's and the
   /// time loop's own (nodal state, stresses); the contact and fracture
@@ -196,7 +196,6 @@ class Simulation {
   std::unique_ptr<Decomposition> dec_;
   ElementForces elements_;
   std::array<ExactSum, kStepWorks> step_work_;  ///< since the last update_ledger(), this rank's part
-  std::unique_ptr<SharedNodes> surface_nodes_;   ///< contact surface vertices shared by all ranks
   /// After a topology change on several ranks: restrict the element loop to
   /// the local elements, renew the plans of the shared nodes.
   void share_plans();

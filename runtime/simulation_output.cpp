@@ -162,7 +162,7 @@ long Simulation::loop_bytes() const {
          b(bc_nodes_) + b(reaction_) + b(x_prev_) + b(stress6_);
 }
 
-void Simulation::write_summary(double wall, const DecompositionStats& stats, std::array<long, 3> owned_pairs,
+void Simulation::write_summary(double wall, const DecompositionStats& stats, const ContactBalance& contact_balance,
                                const CrackArea& crack, const std::pair<std::vector<long>, long>& memory) {
   const Ledger& l = ledger_;
   JsonObject j;
@@ -188,7 +188,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
   j.add("local_elements_max", stats.local_max);
   j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
-  j.add("shared_surface_bytes_per_step", static_cast<long>(surface_nodes_ ? 72 * surface_nodes_->nodes.size() : 0));
+  // No contact surface state goes to every rank any more (the patches, docs/parallel.md).
+  j.add("shared_surface_bytes_per_step", 0L);
   // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
   j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(kLedgerSums) : 0));
   // The contact stage's exchanges included (contact_exchange_time).
@@ -234,15 +235,19 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, std
     const double steps = std::max(1L, cp.steps);
     j.add("contact_verlet_time", cp.verlet_seconds);
     j.add("contact_sweep_time", cp.sweep_seconds);
-    j.add("contact_candidates_per_step", cp.candidates / steps);
-    j.add("contact_pairs_per_step", owned_pairs[2] / steps);
+    j.add("contact_candidates_per_step", contact_balance.candidates_sum / steps);
+    j.add("contact_pairs_per_step", contact_balance.pairs_sum / steps);
     j.add("contact_detections_per_step", cp.detections / steps);
     j.add("contact_sweeps_per_step", cp.sweeps / steps);
     if (dec_->distributed()) {
-      j.add("contact_pairs_per_step_rank_min", owned_pairs[0] / steps);
-      j.add("contact_pairs_per_step_rank_max", owned_pairs[1] / steps);
+      j.add("contact_pairs_per_step_rank_min", contact_balance.pairs_min / steps);
+      j.add("contact_pairs_per_step_rank_max", contact_balance.pairs_max / steps);
       j.add("contact_exchange_time", cp.exchange_seconds);
       j.add("contact_exchange_bytes_per_step", cp.exchange_bytes / steps);
+      j.add("contact_state_bytes_per_step_max", contact_balance.state_bytes_max / steps);
+      j.add("contact_found_bytes_per_step_max", contact_balance.found_bytes_max / steps);
+      j.add("contact_search_cpu_time_max", contact_balance.search_cpu_max);
+      j.add("contact_dcr_cpu_time_max", contact_balance.sweep_cpu_max);
       j.add("contact_repartitions", cp.repartitions);
     }
   }

@@ -109,7 +109,7 @@ long Simulation::run() {
   if (!opt_.out_dir.empty()) {
     const CrackArea crack = fracture_ ? write_fragments() : CrackArea{};
     const DecompositionStats stats = dec_->stats();
-    const std::array<long, 3> pairs = contact_ ? contact_->owned_pairs_range() : std::array<long, 3>{};
+    const ContactBalance pairs = contact_ ? contact_->balance() : ContactBalance{};
     const std::pair<std::vector<long>, long> memory{dec_->gather(peak_memory_bytes()), dec_->max(loop_bytes())};
     if (root) write_summary(wall, stats, pairs, crack, memory);
   }

@@ -201,12 +201,6 @@ int count_penetrations(const Stack& s, const std::vector<Vec3>& x) {
   return bad;
 }
 
-std::vector<Index> every_pair(const Stack& s) {
-  std::vector<Index> all(s.pairs.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Index>(i);
-  return all;
-}
-
 /// The stack's sheets as a contact surface, for the outward normals: on a thin sheet both
 /// sides cancel (none); a stack without triangles gives none at all.
 struct StackSurface {
@@ -220,14 +214,13 @@ struct StackSurface {
   DcrSurface dcr() const { return surface.triangles.empty() ? DcrSurface{} : DcrSurface{&surface, &around}; }
 };
 
-DcrResult run(Stack& s, const DcrOptions& options, std::span<const Index> mine, const DcrGather& gather = {}) {
+DcrResult run(Stack& s, const DcrOptions& options, std::span<const ContactPair> mine, const DcrGather& gather = {}) {
   DcrScratch scratch;
   const StackSurface surface(s);
-  return resolve_contacts(s.pairs, mine, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, surface.dcr(), scratch,
-                          gather);
+  return resolve_contacts(mine, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, options, surface.dcr(), scratch, gather);
 }
 
-DcrResult run(Stack& s, const DcrOptions& options) { return run(s, options, every_pair(s)); }
+DcrResult run(Stack& s, const DcrOptions& options) { return run(s, options, s.pairs); }
 
 struct Totals {
   Vec3 p = Vec3::Zero(), L = Vec3::Zero();
@@ -284,15 +277,15 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
   Stack one = initial, split = initial;
   const DcrOptions options{0.5, 0.3, 1e-6, 200};
   const DcrResult r1 = run(one, options);
-  std::vector<Index> even, odd;
-  for (Index i = 0; i < static_cast<Index>(split.pairs.size()); ++i) (i % 2 ? odd : even).push_back(i);
+  ASSERT_TRUE(std::is_sorted(split.pairs.begin(), split.pairs.end()));
+  ContactPairs even, odd;
+  for (size_t i = 0; i < split.pairs.size(); ++i) (i % 2 ? odd : even).push_back(split.pairs[i]);
   int gathers = 0;
   const StackSurface other(split);
-  const DcrResult r2 = run(split, options, even, [&](std::vector<Index>& found) {
+  const DcrResult r2 = run(split, options, even, [&](std::vector<FoundPair>& found) {
     ++gathers;
     const TriangleNormals tn = triangle_normals(other.surface, split.x_old);
-    for (const Index i : odd) {
-      const ContactPair& p = split.pairs[i];
+    for (const ContactPair& p : odd) {
       PairPoints X_old, X_new;
       for (int k = 0; k < 4; ++k) {
         X_old.col(k) = split.x_old[p.nodes[k]];
@@ -301,9 +294,9 @@ TEST(DcrSweep, DetectionSplitAcrossRanksGivesTheSameBits) {
       const auto kind = p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
       if (pair_boxes_overlap(p.kind, X_old, X_new) &&
           dcr_detect(kind, X_old, X_new, pair_normals(p, other.dcr(), tn)).penetrating)
-        found.push_back(i);
+        found.push_back({p, pair_normals(p, other.dcr(), tn)});
     }
-    std::sort(found.begin(), found.end());
+    std::sort(found.begin(), found.end(), [](const FoundPair& a, const FoundPair& b) { return a.pair < b.pair; });
   });
   EXPECT_GT(r1.contacts, 0);
   EXPECT_EQ(gathers, r2.sweeps);
@@ -378,7 +371,8 @@ TEST(DcrSweep, CapIsReported) {
   const DcrResult r = run(s, {1.0, 0.0, 1e-6, 1});
   EXPECT_EQ(r.sweeps, 1);
   EXPECT_TRUE(r.capped);
-  EXPECT_GE(r.unresolved, 0);
+  ASSERT_TRUE(r.unresolved.has_value());
+  EXPECT_TRUE(std::binary_search(s.pairs.begin(), s.pairs.end(), *r.unresolved));
 }
 
 TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
@@ -404,10 +398,9 @@ TEST(DcrSweep, BitwiseIdenticalForAnyThreadCount) {
 
 TEST(DcrSweep, RejectsInconsistentInput) {
   Stack s = make_stack(2, 2, true, 8);
-  const std::vector<Index> all = every_pair(s);
   DcrScratch scratch;
   std::vector<double> short_inv_mass(s.inv_mass.begin(), s.inv_mass.end() - 1);
-  EXPECT_THROW(resolve_contacts(s.pairs, all, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {}, scratch), Error);
-  const std::vector<Index> beyond{static_cast<Index>(s.pairs.size())};
-  EXPECT_THROW(resolve_contacts(s.pairs, beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {}, scratch), Error);
+  EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {}, scratch), Error);
+  const ContactPairs beyond{{ContactPair::VertexFace, {0, 1, 2, static_cast<Index>(s.x_new.size())}}};
+  EXPECT_THROW(resolve_contacts(beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {}, scratch), Error);
 }

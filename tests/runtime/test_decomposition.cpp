@@ -83,7 +83,7 @@ TEST(Decomposition, OwnershipCoversEverythingOnce) {
   }
 }
 
-TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
+TEST(Decomposition, GhostUpdateAndGatherDeliverTheOwnersValues) {
   const Model& m = box();
   Decomposition d(m, MPI_COMM_WORLD);
   const Index nn = m.mesh.num_nodes();
@@ -93,15 +93,9 @@ TEST(Decomposition, GhostUpdateAndShareDeliverTheOwnersValues) {
   d.begin_ghost_update(x);
   d.end_ghost_update(x);
   for (Index n : d.held_nodes()) EXPECT_TRUE(same_bits(x[n], tag(n))) << "node " << n;
-  // Share every third node with every rank; gather all to rank 0.
-  std::vector<Index> subset;
-  for (Index n = 0; n < nn; n += 3) subset.push_back(n);
-  const SharedNodes plan = d.shared_nodes(subset);
+  // Gather all to rank 0.
   std::vector<Vec3> y(nn, Vec3::Constant(-7.0)), z(nn, Vec3::Constant(-7.0));
   for (Index n : d.touched_nodes()) y[n] = tag(n), z[n] = -tag(n);
-  const std::span<Vec3> arrays[] = {y, z};
-  d.share(plan, arrays);
-  for (Index n : subset) EXPECT_TRUE(same_bits(y[n], tag(n)) && same_bits(z[n], Vec3(-tag(n)))) << "node " << n;
   const std::span<const Vec3> owned[] = {y, z};
   const std::vector<std::vector<Vec3>> whole = d.gather_to_root(owned);
   if (d.rank() == 0) {

@@ -1,0 +1,195 @@
+#include "runtime/contact_patch.hpp"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+
+#include "kernels/error.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/halo.hpp"
+
+namespace shatter {
+
+namespace {
+
+/// The nodes of the listed primitives, ascending and distinct.
+template <size_t K>
+void add_nodes(std::span<const std::array<Index, K>> primitives, std::vector<Index>& nodes) {
+  for (const auto& p : primitives) nodes.insert(nodes.end(), p.begin(), p.end());
+}
+
+void sort_unique(std::vector<Index>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+Box empty_box() {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  return {Vec3::Constant(inf), Vec3::Constant(-inf)};
+}
+
+}  // namespace
+
+SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
+                          double margin) {
+  SweptBoxes boxes = swept_boxes(surface, x_old, x_new);
+  for (auto* list : {&boxes.triangles, &boxes.edges, &boxes.vertices})
+    for (Box& b : *list) {
+      b.lo.array() -= 1.01 * margin;
+      b.hi.array() += 1.01 * margin;
+    }
+  return boxes;
+}
+
+ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
+                           Index num_nodes)
+    : dec_(dec), surface_(surface), around_(around), num_nodes_(num_nodes) {
+  for (const Index n : surface.vertices)
+    if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
+}
+
+ContactPatch::~ContactPatch() = default;
+
+void ContactPatch::own(std::vector<int> primitive_rank) {
+  const auto nt = static_cast<Index>(surface_.triangles.size());
+  SHATTER_REQUIRE(primitive_rank.size() == surface_.triangles.size() + surface_.edges.size(),
+                  "ContactPatch: " << primitive_rank.size() << " ranks for " << nt << " triangles and "
+                                   << surface_.edges.size() << " edges");
+  primitive_rank_ = std::move(primitive_rank);
+  owned_triangles_.clear();
+  owned_edges_.clear();
+  owned_ = {};
+  for (Index q = 0; q < static_cast<Index>(primitive_rank_.size()); ++q) {
+    if (primitive_rank_[q] != dec_.rank()) continue;
+    if (q < nt) {
+      owned_triangles_.push_back(q);
+      owned_.triangles.push_back(surface_.triangles[q]);
+      owned_.body.push_back(surface_.body[q]);
+    } else {
+      owned_edges_.push_back(q - nt);
+      owned_.edges.push_back(surface_.edges[q - nt]);
+    }
+  }
+  add_nodes<3>(owned_.triangles, owned_.vertices);
+  add_nodes<2>(owned_.edges, owned_.vertices);
+  sort_unique(owned_.vertices);
+  plan(owned_.vertices);
+}
+
+void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
+  const int ranks = dec_.size(), me = dec_.rank();
+  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin);
+  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin);
+  Box mine = empty_box();
+  for (const auto* list : {&own.triangles, &own.edges})
+    for (const Box& b : *list) {
+      mine.lo = mine.lo.cwiseMin(b.lo);
+      mine.hi = mine.hi.cwiseMax(b.hi);
+    }
+  std::vector<double> reach(6 * ranks);
+  const double local[6] = {mine.lo.x(), mine.lo.y(), mine.lo.z(), mine.hi.x(), mine.hi.y(), mine.hi.z()};
+  MPI_Allgather(local, 6, MPI_DOUBLE, reach.data(), 6, MPI_DOUBLE, dec_.comm());
+  std::vector<Box> boxes(ranks);
+  for (int r = 0; r < ranks; ++r)
+    boxes[r] = {Vec3(reach[6 * r], reach[6 * r + 1], reach[6 * r + 2]),
+                Vec3(reach[6 * r + 3], reach[6 * r + 4], reach[6 * r + 5])};
+  // Edges as their surface index e >= 0, vertices as -(k + 1) for surface.vertices[k].
+  std::vector<std::vector<Index>> to(ranks);
+  for (size_t k = 0; k < owned_edges_.size(); ++k)
+    for (int r = 0; r < ranks; ++r)
+      if (r != me && boxes_overlap(own.edges[k], boxes[r])) to[r].push_back(owned_edges_[k]);
+  for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
+    for (int r = 0; r < ranks; ++r)
+      if (boxes_overlap(vertex.vertices[k], boxes[r]))
+        to[r].push_back(-(around_.position[volume_vertices_.vertices[k]] + 1));
+  std::vector<Index> edges(owned_edges_), vertices;
+  for (const auto& list : dec_.alltoall(to))
+    for (const Index id : list) (id >= 0 ? edges : vertices).push_back(id >= 0 ? id : -id - 1);
+  sort_unique(edges);
+  sort_unique(vertices);
+  patch_ = {};
+  patch_.triangles = owned_.triangles;
+  patch_.body = owned_.body;
+  for (const Index e : edges) patch_.edges.push_back(surface_.edges[e]);
+  for (const Index k : vertices) patch_.vertices.push_back(surface_.vertices[k]);
+  // The triangles around every node of the patch's primitives orient its pairs.
+  std::vector<Index> nodes = patch_.vertices;
+  add_nodes<3>(patch_.triangles, nodes);
+  add_nodes<2>(patch_.edges, nodes);
+  sort_unique(nodes);
+  normal_triangles_.clear();
+  for (const Index n : nodes) {
+    const Index k = around_.position[n];
+    normal_triangles_.insert(normal_triangles_.end(), around_.items.begin() + around_.offsets[k],
+                             around_.items.begin() + around_.offsets[k + 1]);
+  }
+  sort_unique(normal_triangles_);
+  std::vector<Index> needed;
+  for (const Index t : normal_triangles_)
+    needed.insert(needed.end(), surface_.triangles[t].begin(), surface_.triangles[t].end());
+  sort_unique(needed);
+  plan(needed);
+}
+
+void ContactPatch::plan(const std::vector<Index>& nodes) {
+  const int ranks = dec_.size(), me = dec_.rank();
+  std::map<int, std::vector<Index>> receive;
+  std::vector<std::vector<Index>> requests(ranks);
+  for (const Index n : nodes) {
+    const int owner = dec_.node_owner(n);
+    if (owner == me) continue;
+    receive[owner].push_back(n);
+    requests[owner].push_back(around_.position[n]);
+  }
+  std::map<int, std::vector<Index>> send;
+  const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
+  for (int r = 0; r < ranks; ++r)
+    for (const Index k : asked[r]) send[r].push_back(surface_.vertices[k]);
+  halo_ = std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+}
+
+void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
+  if (!halo_) return;
+  const std::span<Vec3> arrays[] = {x_old, x_new, v};
+  halo_->update_ghosts(arrays);
+}
+
+long ContactPatch::share_found(std::vector<FoundPair>& found, std::span<Vec3> x_old, std::span<Vec3> x_new,
+                               std::span<Vec3> v) const {
+  // Per pair: kind, the surface positions of its 4 nodes, its normals (6), then x_old, x_new
+  // and v of each node (36); integers travel exactly as doubles.
+  constexpr size_t kWidth = 1 + 4 + 6 + 36;
+  std::vector<double> out;
+  out.reserve(kWidth * found.size());
+  for (const FoundPair& f : found) {
+    out.push_back(f.pair.kind);
+    for (const Index n : f.pair.nodes) out.push_back(around_.position[n]);
+    out.insert(out.end(), f.normals.data(), f.normals.data() + 6);
+    for (const Index n : f.pair.nodes)
+      for (const auto* a : {&x_old, &x_new, &v}) out.insert(out.end(), (*a)[n].data(), (*a)[n].data() + 3);
+  }
+  const std::vector<double> all = dec_.allgather(out);
+  found.resize(all.size() / kWidth);
+  for (size_t p = 0; p < found.size(); ++p) {
+    const double* in = all.data() + p * kWidth;
+    FoundPair& f = found[p];
+    f.pair.kind = static_cast<ContactPair::Kind>(in[0]);
+    for (int c = 0; c < 4; ++c) f.pair.nodes[c] = surface_.vertices[static_cast<Index>(in[1 + c])];
+    std::copy_n(in + 5, 6, f.normals.data());
+    for (int c = 0; c < 4; ++c) {
+      const Index n = f.pair.nodes[c];
+      for (int a = 0; a < 3; ++a) {
+        Vec3& value = (a == 0 ? x_old : a == 1 ? x_new : v)[n];
+        value = Vec3(in[11 + 9 * c + 3 * a], in[12 + 9 * c + 3 * a], in[13 + 9 * c + 3 * a]);
+      }
+    }
+  }
+  std::sort(found.begin(), found.end(), [](const FoundPair& a, const FoundPair& b) { return a.pair < b.pair; });
+  return static_cast<long>(sizeof(double) * out.size()) * (dec_.size() - 1);
+}
+
+long ContactPatch::exchange_bytes() const { return halo_ ? static_cast<long>(halo_->update_bytes(9)) : 0; }
+
+}  // namespace shatter

@@ -1,0 +1,92 @@
+#pragma once
+// A rank's share of the contact surface on several MPI ranks (docs/parallel.md
+// "Contact across ranks"): the triangles and edges it owns (a partition of the
+// surface primitives, ContactPartition), the ghost primitives whose boxes reach
+// into the box of its own, and the plan that brings the states of their nodes
+// from the volume owners, point to point, once per step. The search and the
+// detection run on the patch only; no surface state goes to every rank.
+//
+// The surface's topology (triangles, edges, the vertex -> triangle lists) is
+// still held on every rank: memory that grows with the surface, no traffic.
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "contact/candidates.hpp"
+#include "contact/dcr.hpp"
+#include "contact/surface.hpp"
+
+namespace shatter {
+
+class Decomposition;
+class Halo;
+
+/// Swept boxes of a surface's primitives from x_old to x_new (swept_boxes), each grown by
+/// 1.01 margin on every side: the boxes of a search whose candidates serve while every node
+/// stays within margin (ContactStage, "Candidate reuse").
+SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
+                          double margin);
+
+class ContactPatch {
+ public:
+  /// surface, around: the contact surface and its vertex -> triangle lists, held by the
+  /// caller for the patch's lifetime (a new surface needs a new patch); num_nodes: the
+  /// length of the nodal arrays.
+  ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
+               Index num_nodes);
+  ~ContactPatch();
+  ContactPatch(const ContactPatch&) = delete;
+  ContactPatch& operator=(const ContactPatch&) = delete;
+
+  /// A new ownership: the rank of each triangle, then of each edge (the same array on every
+  /// rank). Plans the states of the owned primitives' nodes (collective).
+  void own(std::vector<int> primitive_rank);
+  bool owned_any() const { return !primitive_rank_.empty(); }
+  const std::vector<int>& primitive_rank() const { return primitive_rank_; }
+  /// The triangles and edges owned here (surface indices, ascending) and their nodes.
+  std::span<const Index> owned_triangles() const { return owned_triangles_; }
+  std::span<const Index> owned_edges() const { return owned_edges_; }
+  const ContactSurface& owned() const { return owned_; }
+
+  /// The ghosts for a search over x_old -> x_new with reuse margin `margin` (the owned
+  /// primitives' states must be here): every rank's reach box (the union of its owned
+  /// primitives' inflated boxes) is gathered; the owner of each edge sends it to the ranks
+  /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
+  /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
+  /// reach here; the plan brings the nodes of the triangles around their nodes (the normals
+  /// that orient the pairs). Collective.
+  void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
+  /// The surface the search runs on here (surface order, node ids of the mesh).
+  const ContactSurface& patch() const { return patch_; }
+  /// The triangles whose normals the pairs of the patch read, ascending.
+  std::span<const Index> normal_triangles() const { return normal_triangles_; }
+
+  /// The volume owners' x_old, x_new and v of the planned nodes into the arrays
+  /// (point to point; collective in the plan's ranks). No-op before own().
+  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
+  /// Bytes this rank sends per exchange().
+  long exchange_bytes() const;
+
+  /// DcrGather on several ranks: this rank's pairs found penetrating (with their normals and
+  /// the states of their nodes) to every rank; `found` becomes the union in canonical pair
+  /// order and the states are written into the arrays. Returns the bytes this rank sent.
+  long share_found(std::vector<FoundPair>& found, std::span<Vec3> x_old, std::span<Vec3> x_new,
+                   std::span<Vec3> v) const;
+
+ private:
+  /// Plan the exchange of `nodes` (ascending mesh ids) from their owners (collective).
+  void plan(const std::vector<Index>& nodes);
+
+  const Decomposition& dec_;
+  const ContactSurface& surface_;
+  const VertexTriangles& around_;
+  Index num_nodes_;
+  ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
+  std::vector<int> primitive_rank_;
+  std::vector<Index> owned_triangles_, owned_edges_;
+  ContactSurface owned_, patch_;
+  std::vector<Index> normal_triangles_;
+  std::unique_ptr<Halo> halo_;
+};
+
+}  // namespace shatter
