@@ -114,22 +114,30 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_.body = owned_.body;
   for (const Index e : edges) patch_.edges.push_back(surface_.edges[e]);
   for (const Index k : vertices) patch_.vertices.push_back(surface_.vertices[k]);
-  // The triangles around every node of the patch's primitives orient its pairs.
+  // The triangles around every node of the patch's primitives orient its pairs; their
+  // nodes are planned (marks kept between searches, cleared after use).
   std::vector<Index> nodes = patch_.vertices;
   add_nodes<3>(patch_.triangles, nodes);
   add_nodes<2>(patch_.edges, nodes);
-  sort_unique(nodes);
+  triangle_mark_.resize(surface_.triangles.size(), 0);
+  node_mark_.resize(num_nodes_, 0);
   normal_triangles_.clear();
   for (const Index n : nodes) {
     const Index k = around_.position[n];
-    normal_triangles_.insert(normal_triangles_.end(), around_.items.begin() + around_.offsets[k],
-                             around_.items.begin() + around_.offsets[k + 1]);
+    for (Index i = around_.offsets[k]; i < around_.offsets[k + 1]; ++i) {
+      const Index t = around_.items[i];
+      if (!triangle_mark_[t]) triangle_mark_[t] = 1, normal_triangles_.push_back(t);
+    }
   }
-  sort_unique(normal_triangles_);
+  std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::vector<Index> needed;
-  for (const Index t : normal_triangles_)
-    needed.insert(needed.end(), surface_.triangles[t].begin(), surface_.triangles[t].end());
-  sort_unique(needed);
+  for (const Index t : normal_triangles_) {
+    triangle_mark_[t] = 0;
+    for (const Index n : surface_.triangles[t])
+      if (!node_mark_[n]) node_mark_[n] = 1, needed.push_back(n);
+  }
+  for (const Index n : needed) node_mark_[n] = 0;
+  std::sort(needed.begin(), needed.end());
   plan(needed);
 }
 

@@ -8,6 +8,7 @@
 //
 // The surface's topology (triangles, edges, the vertex -> triangle lists) is
 // still held on every rank: memory that grows with the surface, no traffic.
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -86,6 +87,7 @@ class ContactPatch {
   std::vector<Index> owned_triangles_, owned_edges_;
   ContactSurface owned_, patch_;
   std::vector<Index> normal_triangles_;
+  std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
   std::unique_ptr<Halo> halo_;
 };
 
