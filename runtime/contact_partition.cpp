@@ -14,7 +14,7 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   zz_ = Zoltan_Create(comm);
   SHATTER_REQUIRE(zz_, "Zoltan_Create failed");
   for (const auto& [key, value] : {std::pair{"DEBUG_LEVEL", "0"}, {"LB_METHOD", "RCB"}, {"NUM_GID_ENTRIES", "1"}, {"NUM_LID_ENTRIES", "1"},
-                                   {"OBJ_WEIGHT_DIM", "1"}, {"RETURN_LISTS", "EXPORT"},
+                                   {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "EXPORT"},
                                    {"RCB_REUSE", "0"}, {"KEEP_CUTS", "0"}, {"IMBALANCE_TOL", "1.02"}})
     Zoltan_Set_Param(zz_, key, value);
   Zoltan_Set_Num_Obj_Fn(
@@ -30,7 +30,7 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
         for (size_t k = 0; k < self->ids_.size(); ++k) {
           gids[k] = static_cast<ZOLTAN_ID_TYPE>(self->ids_[k]);
           lids[k] = static_cast<ZOLTAN_ID_TYPE>(k);
-          if (wdim == 1) weights[k] = self->weights_[k];
+          for (int w = 0; w < wdim; ++w) weights[k * wdim + w] = self->weights_[2 * k + w];
         }
         *ierr = ZOLTAN_OK;
       },
@@ -56,7 +56,7 @@ ContactPartition::~ContactPartition() { Zoltan_Destroy(&zz_); }
 
 std::vector<int> ContactPartition::partition(std::span<const Index> ids, std::span<const Vec3> points,
                                              std::span<const float> weights, Index total) {
-  SHATTER_REQUIRE(ids.size() == points.size() && points.size() == weights.size(),
+  SHATTER_REQUIRE(ids.size() == points.size() && 2 * points.size() == weights.size(),
                   "ContactPartition: " << ids.size() << " ids, " << points.size() << " points, " << weights.size()
                                        << " weights");
   ids_ = ids;

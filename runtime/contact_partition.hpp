@@ -25,8 +25,9 @@ class ContactPartition {
 
   /// The part (rank) of each of `total` objects, the same array on every rank
   /// (collective). Each rank passes the objects it holds (ids in [0, total), each id
-  /// on exactly one rank) with their points and weights (>= 0); the parts come back
-  /// through one MPI_Allgatherv.
+  /// on exactly one rank) with their points and two weights each (>= 0, object-major),
+  /// balanced together (Zoltan's multi-criteria RCB); the parts come back through one
+  /// MPI_Allgatherv.
   std::vector<int> partition(std::span<const Index> ids, std::span<const Vec3> points,
                              std::span<const float> weights, Index total);
 
