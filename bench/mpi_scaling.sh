@@ -5,6 +5,8 @@
 #   bench/mpi_scaling.sh BUILD strong [ELEMENTS] [REPEATS]
 #       ranks x threads = 1x1, 1x2, 2x1 on ELEMENTS tets (default 500000),
 #       REPEATS runs each (default 5), interleaved; medians of the loop wall time.
+#   SCENE=FILE bench/mpi_scaling.sh BUILD strong 0 [REPEATS]
+#       the same on the scene FILE as it is (e.g. scenes/cubes76.yaml).
 #   bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
 #       R = 1, 2, 4, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
 #       tets per rank (default 2000), to 2e-4 s (the boxes meet after 5e-5 s):
@@ -82,8 +84,15 @@ contact() {
 if [ "$mode" = strong ]; then
   elements=${3:-500000}
   repeats=${4:-5}
-  h=$(size_for "$elements")
+  sizes=()
   out="$here/results/mpi_scaling_strong.csv"
+  if [ -n "${SCENE:-}" ]; then
+    scene=$SCENE
+    out="$here/results/mpi_scaling_strong_$(basename "$SCENE" .yaml).csv"
+  else
+    h=$(size_for "$elements")
+    sizes=(--set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h")
+  fi
   echo "ranks,threads,elements,steps,wall_median,wall_min,wall_max,element_loop,contact_search,contact_dcr,communication" > "$out"
   # The runs are interleaved (1x1, 1x2, 2x1, 1x1, ...) so that a slow spell of a
   # shared machine falls on every configuration alike, not on one.
@@ -94,7 +103,7 @@ if [ "$mode" = strong ]; then
       set -- $rt
       dir="$work/r$1t$2_$k"
       "${mpi[@]}" --bind-to "$(bind "$2")" -n "$1" "$shatter" run "$scene" --out "$dir" --threads "$2" --quiet \
-        --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
+        "${sizes[@]}"
       wall=$(key "$dir" wall_time)
       runs[$1x$2]+="$wall $dir"$'\n'
       echo "run $k: ${1}x$2 $wall s (load $(cut -d' ' -f1 /proc/loadavg))" >&2
