@@ -1,0 +1,91 @@
+// The contact patches (runtime/contact_patch.hpp) at 1, 2 and 3 ranks: over
+// many steps of two bodies moving into each other (one spinning), the pairs
+// the ranks check together are the pairs a search of the whole surface gives,
+// each on exactly one rank, while every rank knows only its own nodes' states
+// (the others are NaN until the patch brings them from their owners).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "contact/candidates.hpp"
+#include "mpi_environment.hpp"
+#include "runtime/contact_stage.hpp"
+#include "runtime/decomposition.hpp"
+#include "runtime/model.hpp"
+#include "scene_text.hpp"
+
+namespace shatter {
+namespace {
+
+/// A pair list as ints (kind, 4 nodes), for the ranks' gather.
+std::vector<Index> flatten(const ContactPairs& pairs) {
+  std::vector<Index> out;
+  for (const ContactPair& p : pairs) {
+    out.push_back(p.kind);
+    out.insert(out.end(), p.nodes.begin(), p.nodes.end());
+  }
+  return out;
+}
+
+ContactPairs unflatten(const std::vector<Index>& in) {
+  ContactPairs out;
+  for (size_t k = 0; k + 5 <= in.size(); k += 5)
+    out.push_back({static_cast<ContactPair::Kind>(in[k]), {in[k + 1], in[k + 2], in[k + 3], in[k + 4]}});
+  return out;
+}
+
+TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const Model m = build_model(test::scene_from_text(
+      "patch_rank" + std::to_string(rank),
+      "name: patch\n"
+      "time: {end: 1.0}\n"
+      "materials:\n"
+      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+      "bodies:\n"
+      "  - {name: a, material: steel, mesh: {shape: sphere, radius: 0.01, element_size: 0.004}}\n"
+      "  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.02, 0.02], center: [0.021, 0.003, 0], "
+      "element_size: 0.004}}\n"
+      "contact: {}\n"));
+  const Decomposition dec(m, MPI_COMM_WORLD);
+  ContactStage stage(m, ContactSpec{}, &dec);
+  const Index n = m.mesh.num_nodes();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Vec3> x_old = m.mesh.reference, x_new(n), v(n), true_old = x_old, true_new(n);
+  const std::vector<double> inv_mass(n, 0.0);  // DCR moves nothing: only the pair lists are compared
+  const double step = 0.02 * stage.margin();
+  long nonempty = 0;
+  for (int s = 0; s < 300; ++s) {
+    const double angle = 2e-4 * s;
+    for (Index i = 0; i < n; ++i) {
+      const Vec3& X = m.mesh.reference[i];
+      const Vec3 shift((s + 1) * step, 0, 0);
+      true_new[i] = m.mesh.node_body[i] == 0 ? Vec3(Vec3(X.x() * std::cos(angle) - X.y() * std::sin(angle),
+                                                          X.x() * std::sin(angle) + X.y() * std::cos(angle), X.z()) +
+                                                     shift)
+                                              : Vec3(X - shift);
+      // A rank knows the states of the nodes it owns only.
+      const bool mine = !dec.distributed() || dec.node_owner(i) == dec.rank();
+      x_old[i] = mine ? true_old[i] : Vec3::Constant(nan);
+      x_new[i] = mine ? true_new[i] : Vec3::Constant(nan);
+      v[i] = mine ? Vec3::Zero() : Vec3::Constant(nan);
+    }
+    stage.apply(x_old, x_new, v, inv_mass, 1.0);
+    const ContactPairs fresh = find_candidates(stage.surface(), true_old, true_new);
+    ContactPairs all = unflatten(dec.allgather(flatten(stage.active_pairs())));
+    std::sort(all.begin(), all.end());
+    ASSERT_EQ(all, fresh) << "step " << s << ": the ranks' pairs are not the whole surface's, once each";
+    nonempty += !fresh.empty();
+    true_old = true_new;
+  }
+  EXPECT_GT(nonempty, 100);
+  EXPECT_LT(stage.searches(), 40) << "the candidates were not reused";
+  if (dec.distributed()) EXPECT_GT(stage.profile().state_bytes, 0) << "no state travelled";
+}
+
+}  // namespace
+}  // namespace shatter
