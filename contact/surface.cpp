@@ -67,7 +67,9 @@ void merge_unique(std::vector<T>& into, const std::vector<T>& more) {
 
 }  // namespace
 
-ContactSurface build_contact_surface(const Mesh& mesh) {
+ContactSurface build_contact_surface(const Mesh& mesh) { return build_contact_surface(mesh, {}); }
+
+ContactSurface build_contact_surface(const Mesh& mesh, std::span<const std::pair<Index, int>> skip) {
   SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "build_contact_surface: mesh order "
                                                           << mesh.order
                                                           << " (expected 1 = TET4 or 2 = TET10)");
@@ -97,7 +99,8 @@ ContactSurface build_contact_surface(const Mesh& mesh) {
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
     while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-    if (j - i == 1) boundary.emplace_back(faces[i].elem, faces[i].local);
+    if (j - i == 1 && !std::binary_search(skip.begin(), skip.end(), std::pair<Index, int>(faces[i].elem, faces[i].local)))
+      boundary.emplace_back(faces[i].elem, faces[i].local);
     i = j;
   }
   std::sort(boundary.begin(), boundary.end());

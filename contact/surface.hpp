@@ -4,6 +4,7 @@
 // the volume mesh, then extended by the crack faces that fracture opens.
 #include <array>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "kernels/types.hpp"
@@ -54,6 +55,8 @@ struct SurfaceTriangle {
 /// Triangles are listed by element, then local face (then sub-triangle for
 /// TET10). Cost O(E log E).
 ContactSurface build_contact_surface(const Mesh& mesh);
+/// The same without the boundary faces in `skip`: (element, local face), ascending.
+ContactSurface build_contact_surface(const Mesh& mesh, std::span<const std::pair<Index, int>> skip);
 
 /// Append triangles (e.g. crack faces opened by fracture) and update the
 /// vertex and edge lists incrementally: O((t + k) log k + e + v) for k new

@@ -43,7 +43,9 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   else rebuild(model.mesh);
 }
 
-void ContactStage::rebuild(const Mesh& mesh) { set_surface(build_contact_surface(mesh), mesh); }
+void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip) {
+  set_surface(build_contact_surface(mesh, skip), mesh);
+}
 
 void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   surface_ = std::move(surface);

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "contact/dcr.hpp"
@@ -86,9 +87,11 @@ class ContactStage {
   DcrResult apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                   std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {});
 
-  /// Rebuild the surface after fracture split nodes: crack faces whose sides
-  /// no longer share nodes join it, and older triangles get the new node ids.
-  void rebuild(const Mesh& mesh);
+  /// Rebuild the surface after fracture split nodes or freed facets: crack faces
+  /// whose sides no longer share nodes join it, but those in `skip` ((element,
+  /// local face), ascending: the bonded cohesive facets), and older triangles get
+  /// the new node ids.
+  void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {});
 
   const ContactSurface& surface() const { return surface_; }
   /// The candidates of the search in force (on several ranks, this rank's).

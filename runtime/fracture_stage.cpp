@@ -148,6 +148,15 @@ std::vector<Index> FractureStage::debonded(std::span<const Vec3> x) const {
   return debonded_facets(model_.mesh, topology_, cohesive_, laws(), x, mine());
 }
 
+std::vector<std::pair<Index, int>> FractureStage::bonded_faces() const {
+  std::vector<std::pair<Index, int>> faces;
+  for (const Index f : cohesive_.facet)
+    if (topology_.facet_state[f] == FacetState::cohesive)
+      for (int side = 0; side < 2; ++side) faces.emplace_back(topology_.facet_elem[f][side], topology_.facet_face[f][side]);
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
 Index FractureStage::release(std::span<const Index> facets) {
   for (Index f : facets) topology_.facet_state[f] = FacetState::free;
   const Index freed = static_cast<Index>(facets.size());

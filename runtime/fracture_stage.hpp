@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,8 @@ class FractureStage {
   /// the caller).
   Insertion insert(std::span<const Index> facets);
   const Topology& topology() const { return topology_; }
+  /// Both faces (element, local face) of every cohesive facet not yet freed, ascending.
+  std::vector<std::pair<Index, int>> bonded_faces() const;
   /// The facet of each cohesive element.
   std::span<const Index> cohesive_facets() const { return cohesive_.facet; }
 

@@ -289,7 +289,8 @@ void Simulation::apply_fracture() {
   // checked by the owner of its smaller element, which holds both elements'
   // stresses. Every rank frees and inserts the gathered lists (by facet
   // global id) where it holds the facets.
-  fracture_->release(fracture_->facets(dec_->allgather(fracture_->gids(fracture_->debonded(x_)))));
+  const Index freed =
+      fracture_->release(fracture_->facets(dec_->allgather(fracture_->gids(fracture_->debonded(x_)))));
   const std::vector<Index> critical =
       dec_->distributed()
           ? fracture_->facets(dec_->allgather(fracture_->gids(
@@ -298,16 +299,27 @@ void Simulation::apply_fracture() {
   const Index before = fracture_->cohesive_count();
   const Insertion ins = fracture_->insert(critical);
   ledger_.cohesive_elements = fracture_->cohesive_count();
-  if (ledger_.cohesive_elements == before) return;
+  if (ledger_.cohesive_elements == before) {
+    // Freed facets' faces join the contact surface.
+    if (contact_ && freed > 0) rebuild_contact_surface();
+    return;
+  }
   if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
   dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
   // After the node lists: the contact patch asks who owns the new nodes.
-  if (contact_ && !ins.new_nodes.empty()) contact_->rebuild(model_.mesh);
+  if (contact_ && (freed > 0 || !ins.new_nodes.empty())) rebuild_contact_surface();
   share_plans();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
   // unchanged).
   if (!ins.new_nodes.empty()) compute_forces(step_, time_);
+}
+
+void Simulation::rebuild_contact_surface() {
+  // The faces of bonded cohesive facets stay out: their compression penalty keeps
+  // them apart (kernels/cohesive.hpp), and with DCR on the coincident faces too the
+  // two fought (sweeps capped at every step of a ring with contact).
+  contact_->rebuild(model_.mesh, fracture_->bonded_faces());
 }
 
 void Simulation::share_plans() {

@@ -199,6 +199,8 @@ class Simulation {
   /// After a topology change on several ranks: restrict the element loop to
   /// the local elements, renew the plans of the shared nodes.
   void share_plans();
+  /// The contact surface of the cracked mesh, without the bonded cohesive facets' faces.
+  void rebuild_contact_surface();
   std::vector<Vec3> x_, v_, a_, f_int_, f_ext_;
   std::vector<double> inv_mass_;
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component

@@ -96,7 +96,7 @@ void Simulation::restore_state(const SimulationState& s) {
     fracture_->restore(*s.fracture);
     node_arrays_from_model();
     dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
-    if (contact_ && model_.mesh.revision != built_revision) contact_->rebuild(model_.mesh);
+    if (contact_ && model_.mesh.revision != built_revision) rebuild_contact_surface();
     share_plans();
   }
   const size_t n = model_.mesh.num_nodes();
