@@ -158,6 +158,34 @@ TEST(ContactSurface, AddTrianglesEqualsRebuildOnTheUnion) {
   }
 }
 
+// The faces of bonded cohesive facets stay out of the contact surface
+// (build_contact_surface with a skip list): skipping every face of some
+// elements removes exactly their boundary triangles.
+TEST(ContactSurface, SkippedFacesAreLeftOut) {
+  const Mesh m = ball(1, Vec3::Zero(), 0);
+  const ContactSurface whole = build_contact_surface(m);
+  std::vector<std::pair<Index, int>> skip;
+  std::vector<std::array<Index, 3>> skipped_keys;
+  for (Index e = 0; e < m.num_elements(); e += 7)
+    for (int f = 0; f < 4; ++f) {
+      skip.emplace_back(e, f);
+      std::array<Index, 3> key;
+      for (int k = 0, j = 0; k < 4; ++k)
+        if (k != 3 - f) key[j++] = m.element(e)[k];
+      std::sort(key.begin(), key.end());
+      skipped_keys.push_back(key);
+    }
+  std::sort(skipped_keys.begin(), skipped_keys.end());
+  std::vector<SurfaceTriangle> kept;
+  for (Index t = 0; t < whole.num_triangles(); ++t) {
+    std::array<Index, 3> key = whole.triangles[t];
+    std::sort(key.begin(), key.end());
+    if (!std::binary_search(skipped_keys.begin(), skipped_keys.end(), key)) kept.push_back({whole.triangles[t], 0});
+  }
+  ASSERT_LT(kept.size(), whole.triangles.size()) << "no boundary face was skipped";
+  EXPECT_EQ(build_contact_surface(m, skip), make_contact_surface(kept));
+}
+
 TEST(ContactSurface, ExtendingAMeshSurfaceEqualsBuildingTheUnion) {
   Mesh a = ball(1, Vec3::Zero(), 0);
   const Mesh b = ball(1, Vec3(3, 0, 0), 1);
