@@ -43,6 +43,20 @@ inline std::string steel_box_scene(const std::string& name, const std::string& e
 }
 
 /// A double as scene text, every bit kept (%.17g).
+/// A steel sphere (radius 10 mm) and a 20 mm steel box beside it, with contact:
+/// the contact stage's tests move them into each other.
+inline std::string sphere_and_box_contact_scene(const std::string& name) {
+  return "name: " + name + "\n"
+         "time: {end: 1.0}\n"
+         "materials:\n"
+         "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+         "bodies:\n"
+         "  - {name: a, material: steel, mesh: {shape: sphere, radius: 0.01, element_size: 0.004}}\n"
+         "  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.02, 0.02], center: [0.021, 0.003, 0], "
+         "element_size: 0.004}}\n"
+         "contact: {}\n";
+}
+
 inline std::string num(double a) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", a);

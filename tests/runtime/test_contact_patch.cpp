@@ -40,17 +40,8 @@ ContactPairs unflatten(const std::vector<Index>& in) {
 TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const Model m = build_model(test::scene_from_text(
-      "patch_rank" + std::to_string(rank),
-      "name: patch\n"
-      "time: {end: 1.0}\n"
-      "materials:\n"
-      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-      "bodies:\n"
-      "  - {name: a, material: steel, mesh: {shape: sphere, radius: 0.01, element_size: 0.004}}\n"
-      "  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.02, 0.02], center: [0.021, 0.003, 0], "
-      "element_size: 0.004}}\n"
-      "contact: {}\n"));
+  const Model m = build_model(
+      test::scene_from_text("patch_rank" + std::to_string(rank), test::sphere_and_box_contact_scene("patch")));
   const Decomposition dec(m, MPI_COMM_WORLD);
   ContactStage stage(m, ContactSpec{}, &dec);
   const Index n = m.mesh.num_nodes();

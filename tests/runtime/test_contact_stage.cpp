@@ -13,17 +13,8 @@
 using namespace shatter;
 
 TEST(ContactStage, ReusedCandidatesEqualAFreshSearchEveryStep) {
-  const Model m = build_model(shatter::test::scene_from_text(
-      "stage",
-      "name: stage\n"
-      "time: {end: 1.0}\n"
-      "materials:\n"
-      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
-      "bodies:\n"
-      "  - {name: a, material: steel, mesh: {shape: sphere, radius: 0.01, element_size: 0.004}}\n"
-      "  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.02, 0.02], center: [0.021, 0.003, 0], "
-      "element_size: 0.004}}\n"
-      "contact: {}\n"));
+  const Model m = build_model(
+      shatter::test::scene_from_text("stage", shatter::test::sphere_and_box_contact_scene("stage")));
   ContactStage stage(m, ContactSpec{});
   const Index n = m.mesh.num_nodes();
   std::vector<Vec3> x_old = m.mesh.reference, x_new(n), v(n, Vec3::Zero());
