@@ -43,8 +43,33 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   else rebuild(model.mesh);
 }
 
-void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip) {
+void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip,
+                           std::span<const std::array<Index, 2>> twins) {
+  twin_of_.clear();
+  if (!twins.empty()) {
+    // Union-find over the twin pairs, each class represented by its smallest node.
+    twin_of_.resize(mesh.num_nodes());
+    std::iota(twin_of_.begin(), twin_of_.end(), 0);
+    auto root = [&](Index n) {
+      while (twin_of_[n] != n) n = twin_of_[n] = twin_of_[twin_of_[n]];
+      return n;
+    };
+    for (const auto& [a, b] : twins) {
+      const Index ra = root(a), rb = root(b);
+      twin_of_[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of_[n] = root(n);
+  }
   set_surface(build_contact_surface(mesh, skip), mesh);
+}
+
+bool ContactStage::joined(const ContactPair& p) const {
+  if (twin_of_.empty()) return false;
+  const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
+  for (int i = 0; i < first; ++i)
+    for (int j = first; j < 4; ++j)
+      if (twin_of_[p.nodes[i]] == twin_of_[p.nodes[j]]) return true;
+  return false;
 }
 
 void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
@@ -96,6 +121,7 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   } else {
     const double cpu0 = cpu_seconds();
     pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_));
+    std::erase_if(pairs_, [&](const ContactPair& p) { return joined(p); });
     profile_.search_cpu_seconds += cpu_seconds() - cpu0;
   }
   x_search_.assign(x_new.begin(), x_new.end());
@@ -159,7 +185,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
         SHATTER_ASSERT(it != surface_.edges.end() && *it == edge);
         q = nt + static_cast<Index>(it - surface_.edges.begin());
       }
-      if (rank[q] != dec_->rank()) continue;
+      if (rank[q] != dec_->rank() || joined(p)) continue;
       pairs_.push_back(p);
       weight_[q] += 1.0f;
     }

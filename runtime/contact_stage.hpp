@@ -90,8 +90,11 @@ class ContactStage {
   /// Rebuild the surface after fracture split nodes or freed facets: crack faces
   /// whose sides no longer share nodes join it, but those in `skip` ((element,
   /// local face), ascending: the bonded cohesive facets), and older triangles get
-  /// the new node ids.
-  void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {});
+  /// the new node ids. The nodes of each pair in `twins` (those a bonded facet
+  /// joins) count as one node: no pair is made of primitives that share one, as
+  /// none is of primitives sharing a node.
+  void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {},
+               std::span<const std::array<Index, 2>> twins = {});
 
   const ContactSurface& surface() const { return surface_; }
   /// The candidates of the search in force (on several ranks, this rank's).
@@ -116,6 +119,8 @@ class ContactStage {
   /// margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
+  /// Whether the pair's primitives share a node, twins counted as one (rebuild).
+  bool joined(const ContactPair& p) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
@@ -132,6 +137,7 @@ class ContactStage {
   double margin_ = 0;
   bool have_candidates_ = false;
   ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
+  std::vector<Index> twin_of_;  ///< per node, its twins' representative (the smallest id); empty: no twins
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;

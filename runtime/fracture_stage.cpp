@@ -157,6 +157,19 @@ std::vector<std::pair<Index, int>> FractureStage::bonded_faces() const {
   return faces;
 }
 
+std::vector<std::array<Index, 2>> FractureStage::bonded_twins() const {
+  std::vector<std::array<Index, 2>> twins;
+  for (Index c = 0; c < cohesive_.size(); ++c) {
+    if (topology_.facet_state[cohesive_.facet[c]] != FacetState::cohesive) continue;
+    // kCohesiveSlots per element: side 0's facet nodes, then side 1's, matched slot by slot.
+    constexpr int kSide = kCohesiveSlots / 2;
+    const Index* side = cohesive_.side_nodes.data() + static_cast<size_t>(c) * kCohesiveSlots;
+    for (int j = 0; j < kSide; ++j)
+      if (side[j] >= 0 && side[j] != side[kSide + j]) twins.push_back({side[j], side[kSide + j]});
+  }
+  return twins;
+}
+
 Index FractureStage::release(std::span<const Index> facets) {
   for (Index f : facets) topology_.facet_state[f] = FacetState::free;
   const Index freed = static_cast<Index>(facets.size());

@@ -109,6 +109,8 @@ class FractureStage {
   const Topology& topology() const { return topology_; }
   /// Both faces (element, local face) of every cohesive facet not yet freed, ascending.
   std::vector<std::pair<Index, int>> bonded_faces() const;
+  /// The node pairs (side 0, side 1) that a cohesive facet not yet freed joins.
+  std::vector<std::array<Index, 2>> bonded_twins() const;
   /// The facet of each cohesive element.
   std::span<const Index> cohesive_facets() const { return cohesive_.facet; }
 

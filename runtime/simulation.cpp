@@ -316,10 +316,11 @@ void Simulation::apply_fracture() {
 }
 
 void Simulation::rebuild_contact_surface() {
-  // The faces of bonded cohesive facets stay out: their compression penalty keeps
-  // them apart (kernels/cohesive.hpp), and with DCR on the coincident faces too the
-  // two fought (sweeps capped at every step of a ring with contact).
-  contact_->rebuild(model_.mesh, fracture_->bonded_faces());
+  // The faces of bonded cohesive facets stay out, and the nodes they join count as
+  // one for the pairs: their compression penalty keeps them apart
+  // (kernels/cohesive.hpp), and with DCR on the coincident faces and the edges of
+  // the crack mouth too the two fought (the sweep cap reached).
+  contact_->rebuild(model_.mesh, fracture_->bonded_faces(), fracture_->bonded_twins());
 }
 
 void Simulation::share_plans() {
