@@ -166,32 +166,43 @@ void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::s
 
 long ContactPatch::share_found(std::vector<FoundPair>& found, std::span<Vec3> x_old, std::span<Vec3> x_new,
                                std::span<Vec3> v) const {
-  // Per pair: kind, the surface positions of its 4 nodes, its normals (6), then x_old, x_new
-  // and v of each node (36); integers travel exactly as doubles.
-  constexpr size_t kWidth = 1 + 4 + 6 + 36;
+  // A rank's part: the counts of its pairs and of their distinct nodes; per pair its kind,
+  // the surface positions of its 4 nodes and its normals (6); per node its surface position
+  // and x_old, x_new, v (9). Integers travel exactly as doubles.
+  constexpr size_t kPair = 1 + 4 + 6, kNode = 1 + 9;
+  std::vector<Index> nodes;
+  for (const FoundPair& f : found) nodes.insert(nodes.end(), f.pair.nodes.begin(), f.pair.nodes.end());
+  sort_unique(nodes);
   std::vector<double> out;
-  out.reserve(kWidth * found.size());
+  out.reserve(2 + kPair * found.size() + kNode * nodes.size());
+  out.push_back(static_cast<double>(found.size()));
+  out.push_back(static_cast<double>(nodes.size()));
   for (const FoundPair& f : found) {
     out.push_back(f.pair.kind);
     for (const Index n : f.pair.nodes) out.push_back(around_.position[n]);
     out.insert(out.end(), f.normals.data(), f.normals.data() + 6);
-    for (const Index n : f.pair.nodes)
-      for (const auto* a : {&x_old, &x_new, &v}) out.insert(out.end(), (*a)[n].data(), (*a)[n].data() + 3);
+  }
+  for (const Index n : nodes) {
+    out.push_back(around_.position[n]);
+    for (const auto* a : {&x_old, &x_new, &v}) out.insert(out.end(), (*a)[n].data(), (*a)[n].data() + 3);
   }
   const std::vector<double> all = dec_.allgather(out);
-  found.resize(all.size() / kWidth);
-  for (size_t p = 0; p < found.size(); ++p) {
-    const double* in = all.data() + p * kWidth;
-    FoundPair& f = found[p];
-    f.pair.kind = static_cast<ContactPair::Kind>(in[0]);
-    for (int c = 0; c < 4; ++c) f.pair.nodes[c] = surface_.vertices[static_cast<Index>(in[1 + c])];
-    std::copy_n(in + 5, 6, f.normals.data());
-    for (int c = 0; c < 4; ++c) {
-      const Index n = f.pair.nodes[c];
-      for (int a = 0; a < 3; ++a) {
-        Vec3& value = (a == 0 ? x_old : a == 1 ? x_new : v)[n];
-        value = Vec3(in[11 + 9 * c + 3 * a], in[12 + 9 * c + 3 * a], in[13 + 9 * c + 3 * a]);
-      }
+  found.clear();
+  for (size_t at = 0; at < all.size();) {
+    const auto pairs = static_cast<size_t>(all[at]), count = static_cast<size_t>(all[at + 1]);
+    at += 2;
+    for (size_t p = 0; p < pairs; ++p, at += kPair) {
+      FoundPair f;
+      f.pair.kind = static_cast<ContactPair::Kind>(all[at]);
+      for (int c = 0; c < 4; ++c) f.pair.nodes[c] = surface_.vertices[static_cast<Index>(all[at + 1 + c])];
+      std::copy_n(&all[at + 5], 6, f.normals.data());
+      found.push_back(f);
+    }
+    for (size_t k = 0; k < count; ++k, at += kNode) {
+      const Index n = surface_.vertices[static_cast<Index>(all[at])];
+      x_old[n] = Vec3(all[at + 1], all[at + 2], all[at + 3]);
+      x_new[n] = Vec3(all[at + 4], all[at + 5], all[at + 6]);
+      v[n] = Vec3(all[at + 7], all[at + 8], all[at + 9]);
     }
   }
   std::sort(found.begin(), found.end(), [](const FoundPair& a, const FoundPair& b) { return a.pair < b.pair; });
