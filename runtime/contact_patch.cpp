@@ -116,27 +116,31 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (const Index k : vertices) patch_.vertices.push_back(surface_.vertices[k]);
   // The triangles around every node of the patch's primitives orient its pairs; their
   // nodes are planned (marks kept between searches, cleared after use).
-  std::vector<Index> nodes = patch_.vertices;
-  add_nodes<3>(patch_.triangles, nodes);
-  add_nodes<2>(patch_.edges, nodes);
   triangle_mark_.resize(surface_.triangles.size(), 0);
   node_mark_.resize(num_nodes_, 0);
+  std::vector<Index> needed;
+  auto add = [&](Index n) {
+    if (!node_mark_[n]) node_mark_[n] = 1, needed.push_back(n);
+  };
+  for (const Index n : patch_.vertices) add(n);
+  for (const auto& t : patch_.triangles)
+    for (const Index n : t) add(n);
+  for (const auto& e : patch_.edges)
+    for (const Index n : e) add(n);
   normal_triangles_.clear();
-  for (const Index n : nodes) {
-    const Index k = around_.position[n];
-    for (Index i = around_.offsets[k]; i < around_.offsets[k + 1]; ++i) {
+  for (size_t k = 0, nodes = needed.size(); k < nodes; ++k) {
+    const Index p = around_.position[needed[k]];
+    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i) {
       const Index t = around_.items[i];
       if (!triangle_mark_[t]) triangle_mark_[t] = 1, normal_triangles_.push_back(t);
     }
   }
-  std::sort(normal_triangles_.begin(), normal_triangles_.end());
-  std::vector<Index> needed;
   for (const Index t : normal_triangles_) {
     triangle_mark_[t] = 0;
-    for (const Index n : surface_.triangles[t])
-      if (!node_mark_[n]) node_mark_[n] = 1, needed.push_back(n);
+    for (const Index n : surface_.triangles[t]) add(n);
   }
   for (const Index n : needed) node_mark_[n] = 0;
+  std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::sort(needed.begin(), needed.end());
   plan(needed);
 }
