@@ -38,6 +38,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   options_.max_sweeps = spec.max_sweeps;
   margin_fraction_ = spec.search_margin;
   options_.placement = spec.placement;
+  body_pairs_ = spec.pairs;
   // A part of the model brings the whole model's surface.
   if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
   else rebuild(model.mesh);
@@ -63,9 +64,14 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
   set_surface(build_contact_surface(mesh, skip), mesh);
 }
 
-bool ContactStage::joined(const ContactPair& p) const {
-  if (twin_of_.empty()) return false;
+bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
+  if (!body_pairs_.empty()) {
+    const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
+    if (!std::binary_search(body_pairs_.begin(), body_pairs_.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)}))
+      return true;
+  }
+  if (twin_of_.empty()) return false;
   for (int i = 0; i < first; ++i)
     for (int j = first; j < 4; ++j)
       if (twin_of_[p.nodes[i]] == twin_of_[p.nodes[j]]) return true;
@@ -84,6 +90,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   }
   have_candidates_ = false;
   pairs_.clear();
+  if (!body_pairs_.empty()) node_body_ = mesh.node_body;
   if (!dec_) return;
   triangle_order_.resize(surface_.triangles.size());
   std::iota(triangle_order_.begin(), triangle_order_.end(), 0);
@@ -121,7 +128,7 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   } else {
     const double cpu0 = cpu_seconds();
     pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_));
-    std::erase_if(pairs_, [&](const ContactPair& p) { return joined(p); });
+    std::erase_if(pairs_, [&](const ContactPair& p) { return excluded(p); });
     profile_.search_cpu_seconds += cpu_seconds() - cpu0;
   }
   x_search_.assign(x_new.begin(), x_new.end());
@@ -185,7 +192,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
         SHATTER_ASSERT(it != surface_.edges.end() && *it == edge);
         q = nt + static_cast<Index>(it - surface_.edges.begin());
       }
-      if (rank[q] != dec_->rank() || joined(p)) continue;
+      if (rank[q] != dec_->rank() || excluded(p)) continue;
       pairs_.push_back(p);
       weight_[q] += 1.0f;
     }

@@ -119,8 +119,9 @@ class ContactStage {
   /// margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
-  /// Whether the pair's primitives share a node, twins counted as one (rebuild).
-  bool joined(const ContactPair& p) const;
+  /// Whether the pair is left out: its primitives share a node, twins counted as one
+  /// (rebuild), or its bodies are not a pair of contact.pairs.
+  bool excluded(const ContactPair& p) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
@@ -138,6 +139,8 @@ class ContactStage {
   bool have_candidates_ = false;
   ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
   std::vector<Index> twin_of_;  ///< per node, its twins' representative (the smallest id); empty: no twins
+  std::vector<std::array<int, 2>> body_pairs_;  ///< contact.pairs (empty: all)
+  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;

@@ -601,7 +601,26 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
   if (const YAML::Node c = root["contact"]) {
     ContactSpec cs;
     if (!c.IsNull()) {
-      r.only_keys(c, "contact", {"friction", "restitution", "max_sweeps", "search_margin", "placement", "on_sweep_cap"});
+      r.only_keys(c, "contact",
+                  {"friction", "restitution", "max_sweeps", "search_margin", "placement", "on_sweep_cap", "pairs"});
+      if (const YAML::Node p = c["pairs"]) {
+        if (!p.IsSequence() || p.size() == 0) r.fail("contact.pairs", "a list of body name pairs [[a, b], ...]", p);
+        for (std::size_t k = 0; k < p.size(); ++k) {
+          const std::string key = "contact.pairs[" + std::to_string(k) + "]";
+          if (!p[k].IsSequence() || p[k].size() != 2) r.fail(key, "a pair of body names [a, b]", p[k]);
+          std::array<int, 2> pair{};
+          for (int j = 0; j < 2; ++j) {
+            const std::string name = r.string(p[k][j], key + "[" + std::to_string(j) + "]");
+            pair[j] = -1;
+            for (std::size_t b = 0; b < s.bodies.size(); ++b)
+              if (s.bodies[b].name == name) pair[j] = static_cast<int>(b);
+            if (pair[j] < 0) r.fail(key + "[" + std::to_string(j) + "]", "the name of a body", p[k][j]);
+          }
+          cs.pairs.push_back({std::min(pair[0], pair[1]), std::max(pair[0], pair[1])});
+        }
+        std::sort(cs.pairs.begin(), cs.pairs.end());
+        cs.pairs.erase(std::unique(cs.pairs.begin(), cs.pairs.end()), cs.pairs.end());
+      }
       if (c["friction"]) {
         cs.friction = r.number(c["friction"], "contact.friction");
         if (cs.friction < 0) r.fail("contact.friction", "a Coulomb coefficient >= 0", c["friction"]);

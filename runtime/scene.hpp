@@ -79,6 +79,9 @@ struct ContactSpec {
   double search_margin = 0.1; ///< candidate reuse margin, fraction of the median surface edge (contact.search_margin)
   DcrPlacement placement = DcrPlacement::End;  ///< contact.placement: end, middle or impact
   bool sweep_cap_fatal = false;  ///< contact.on_sweep_cap: fail (the run stops, exit 1) instead of warn
+  /// contact.pairs: the body pairs (indices, a <= b; a == b: a body's self-contact) that may
+  /// touch, ascending; empty: every pair, self-contact included.
+  std::vector<std::array<int, 2>> pairs;
 };
 
 struct CheckpointSpec {

@@ -23,6 +23,7 @@
 #include "expect_close.hpp"
 #include "runtime/contact_stage.hpp"
 #include "runtime/model.hpp"
+#include "runtime/scene.hpp"
 #include "runtime/simulation.hpp"
 #include "run_checks.hpp"
 #include "scene_text.hpp"
@@ -364,4 +365,34 @@ TEST(ContactRuns, SearchMarginChangesTheCostNotTheResult) {
     EXPECT_EQ(0, std::memcmp(x[k].data(), x[0].data(), x[0].size() * sizeof(Vec3)));
     EXPECT_EQ(0, std::memcmp(v[k].data(), v[0].data(), v[0].size() * sizeof(Vec3)));
   }
+}
+
+// contact.pairs (SCENE.md): the five cubes with only [hub, west] listed. The
+// three other cubes fly through the hub as if it were not there (their velocity
+// unchanged to the last bit, since nothing else acts on them), while the hub and
+// west collide, and momentum is kept.
+TEST(ContactRuns, UnlistedBodyPairsPassThroughEachOther) {
+  const std::string path = std::string(SHATTER_SOURCE_DIR) + "/scenes/regression/five_cubes.yaml";
+  Model model = build_model(load_scene(path, {"contact.pairs=[[hub, west]]", "time.end=0.04"}));
+  Simulation sim(model, {});
+  auto velocity = [&](int body) {
+    Vec3 p = Vec3::Zero();
+    for (Index i = 0; i < model.mesh.num_nodes(); ++i)
+      if (model.mesh.node_body[i] == body) p += model.mass[i] * sim.velocities()[i];
+    return Vec3(p / model.body_mass[body]);
+  };
+  std::vector<Vec3> before;
+  for (int b = 0; b < 5; ++b) before.push_back(velocity(b));
+  const Vec3 p0 = sim.ledger().momentum;
+  long contacts = 0;
+  while (sim.time() < model.scene.end_time * (1 - 1e-12)) {
+    sim.step();
+    contacts = std::max(contacts, sim.ledger().contacts);
+  }
+  EXPECT_GT(contacts, 0);
+  EXPECT_GT((velocity(0) - before[0]).norm(), 1.0) << "the hub was not hit by west";
+  EXPECT_GT((velocity(1) - before[1]).norm(), 1.0) << "west did not bounce off the hub";
+  for (int b = 2; b < 5; ++b)
+    EXPECT_LT((velocity(b) - before[b]).norm(), 1e-12 * before[b].norm()) << "body " << b << " touched another";
+  EXPECT_LT((sim.ledger().momentum - p0).norm(), 1e-12 * 5 * 0.0785 * 25);
 }
