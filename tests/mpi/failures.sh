@@ -14,10 +14,12 @@
 #   - bad input on every rank: exit 2, one error line;
 #   - a mesh too small for the ranks (fewer granules of 256 elements than
 #     ranks): exit 2, one error line that says how many ranks it can take.
-# A hang is caught by `timeout` (and ctest's TIMEOUT).
+# A hang is caught by `timeout` (and ctest's TIMEOUT), 100 s a run times the
+# sanitized build's SHATTER_TEST_TIMEOUT_SCALE (tests/CMakeLists.txt).
 # usage: failures.sh SHATTER FAIL_ALONE MPIEXEC WORKDIR
 set -uo pipefail
 shatter=$1 fail_alone=$2 mpiexec=$3 work=$4
+limit=$((100 * ${SHATTER_TEST_TIMEOUT_SCALE:-1}))
 rm -rf "$work"
 mkdir -p "$work"
 cat > "$work/box.yaml" <<'YAML'
@@ -40,7 +42,7 @@ fail=0
 run() {
   local name=$1 want=$2 message=$3
   shift 3
-  timeout -k 10 100 env "$@" > "$work/$name.log" 2>&1
+  timeout -k 10 "$limit" env "$@" > "$work/$name.log" 2>&1
   local status=$?
   local errors
   errors=$(grep -c '^error: ' "$work/$name.log")
@@ -70,7 +72,7 @@ grep -q "the last good state (step " "$work/collective.log" && [ -f "$work/colle
 crush=(--set time.end=1.0e-4 --set "bodies[0].mesh.size=[0.01, 0.01, 0.01]" --set "bodies[0].angular_velocity=[0, 0, 0]"
   --set "boundary_conditions=[{body: b, region: {box: [[-1, -1, -1], [-0.0049, 1, 1]]}, velocity: [300, null, null]}, {body: b, region: {box: [[0.0049, -1, -1], [1, 1, 1]]}, velocity: [0, null, null]}]")
 run collapse 1 "the stable step collapsed" "${mpi[@]}" --out "$work/collapse" "${crush[@]}"
-timeout -k 10 100 "$shatter" run "$work/box.yaml" --threads 1 --quiet --out "$work/collapse1" "${crush[@]}" > "$work/collapse1.log" 2>&1
+timeout -k 10 "$limit" "$shatter" run "$work/box.yaml" --threads 1 --quiet --out "$work/collapse1" "${crush[@]}" > "$work/collapse1.log" 2>&1
 [ "$(grep '^error: ' "$work/collapse.log")" = "$(grep '^error: ' "$work/collapse1.log")" ] && [ -f "$work/collapse/checkpoint.h5" ] ||
   { echo "FAIL collapse: not the message of one rank, or no checkpoint:"; cat "$work/collapse1.log"; fail=1; }
 

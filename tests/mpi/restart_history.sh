@@ -15,7 +15,7 @@ rows=$(wc -l < "$work/whole/history.csv")
 "${mpi[@]}" -n 4 "$shatter" run "$scene" --out "$work/cut" --threads 1 --quiet 2> "$work/cut.log" &
 job=$!
 # Stop it after about a third of the rows.
-for _ in $(seq 1 600); do
+for _ in $(seq 1 $((600 * ${SHATTER_TEST_TIMEOUT_SCALE:-1}))); do
   sleep 0.1
   [ -f "$work/cut/history.csv" ] && [ "$(wc -l < "$work/cut/history.csv")" -gt $((rows / 3)) ] && break
 done
