@@ -1,7 +1,5 @@
 #include "runtime/contact_patch.hpp"
 
-#include <mpi.h>
-
 #include <algorithm>
 #include <limits>
 #include <map>
@@ -14,7 +12,7 @@ namespace shatter {
 
 namespace {
 
-/// The nodes of the listed primitives, ascending and distinct.
+/// Appends the nodes of the listed primitives to `nodes` (with repeats).
 template <size_t K>
 void add_nodes(std::span<const std::array<Index, K>> primitives, std::vector<Index>& nodes) {
   for (const auto& p : primitives) nodes.insert(nodes.end(), p.begin(), p.end());
@@ -88,9 +86,8 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
       mine.lo = mine.lo.cwiseMin(b.lo);
       mine.hi = mine.hi.cwiseMax(b.hi);
     }
-  std::vector<double> reach(6 * ranks);
   const double local[6] = {mine.lo.x(), mine.lo.y(), mine.lo.z(), mine.hi.x(), mine.hi.y(), mine.hi.z()};
-  MPI_Allgather(local, 6, MPI_DOUBLE, reach.data(), 6, MPI_DOUBLE, dec_.comm());
+  const std::vector<double> reach = dec_.allgather(std::span<const double>(local));
   std::vector<Box> boxes(ranks);
   for (int r = 0; r < ranks; ++r)
     boxes[r] = {Vec3(reach[6 * r], reach[6 * r + 1], reach[6 * r + 2]),
