@@ -7,8 +7,8 @@
 #       REPEATS runs each (default 5), interleaved; medians of the loop wall time.
 #   SCENE=FILE bench/mpi_scaling.sh BUILD strong 0 [REPEATS]
 #       the same on the scene FILE as it is (e.g. scenes/cubes76.yaml).
-#   bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
-#       R = 1, 2, 4, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
+#   [FIRST=R0] bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
+#       R = R0 (default 1), 2 R0, 4 R0, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
 #       tets per rank (default 2000), to 2e-4 s (the boxes meet after 5e-5 s):
 #       balance of elements and contact pairs and bytes per rank per step from
 #       summary.json; of the times, only the contact's thread CPU times per
@@ -152,7 +152,7 @@ else
   max_ranks=${4:-64}
   out="$here/results/mpi_scaling_weak.csv"
   echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,contact_searches,contact_repartitions,contact_state_bytes_max,contact_found_bytes_max,contact_search_cpu_ms_per_step_max,contact_dcr_cpu_ms_per_step_max" > "$out"
-  r=1
+  r=${FIRST:-1}
   while [ "$r" -le "$max_ranks" ]; do
     h=$(size_for $((per_rank * r)))
     dir="$work/weak$r"

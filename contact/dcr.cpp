@@ -4,10 +4,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <map>
+#include <numeric>
 
 #include "contact/candidates.hpp"
 #include "kernels/error.hpp"
-#include "mesh/coloring.hpp"
 
 namespace shatter {
 
@@ -24,26 +25,101 @@ DcrPairKind dcr_kind(const ContactPair& p) {
   return p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
 }
 
-/// The greedy coloring of the found pairs in their order, over their nodes numbered compactly
-/// (first appearance) with slot_of, a per-node scratch of -1 that is left so.
-Coloring color_found(std::span<const FoundPair> found, std::vector<Index>& slot_of) {
-  std::vector<Index> offsets(found.size() + 1), slots(4 * found.size());
-  std::vector<Index> seen;
-  Index n_slots = 0;
-  for (size_t k = 0; k < found.size(); ++k) {
-    offsets[k] = static_cast<Index>(4 * k);
-    for (int c = 0; c < 4; ++c) {
-      const Index n = found[k].pair.nodes[c];
-      if (slot_of[n] < 0) {
-        slot_of[n] = n_slots++;
-        seen.push_back(n);
-      }
-      slots[4 * k + c] = slot_of[n];
+/// What resolving one found pair did.
+struct Outcome {
+  bool active = false;
+  double dissipated = 0, support_work = 0;
+};
+
+/// Re-detects the found pair at its turn and resolves it (dcr_resolve_pair), writing its
+/// nodes' new states and moved stamps when it acts.
+Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<const Vec3> x_old, std::span<Vec3> v,
+                      std::span<const double> inv_mass, std::span<const std::uint8_t> held_masks, const DcrLaw& law,
+                      double dt, std::vector<long>& moved, long stamp) {
+  const ContactPair& p = found.pair;
+  PairPoints X_old, X_new, V, W;
+  PairWeights w;
+  bool held = false, driven = false;  // a held component; one held at a non-zero velocity
+  for (int i = 0; i < 4; ++i) {
+    const Index n = p.nodes[i];
+    X_old.col(i) = x_old[n];
+    X_new.col(i) = x_new[n];
+    V.col(i) = v[n];
+    w[i] = inv_mass[n];
+    const std::uint8_t h = held_masks.empty() ? 0 : held_masks[n];
+    for (int c = 0; c < 3; ++c) {
+      const bool hc = (h >> c) & 1u;
+      W(c, i) = hc ? 0.0 : w[i];
+      held = held || hc;
+      driven = driven || (hc && V(c, i) != 0.0);
     }
   }
-  offsets[found.size()] = static_cast<Index>(4 * found.size());
-  for (const Index n : seen) slot_of[n] = -1;
-  return greedy_coloring(offsets, slots, n_slots);
+  const PairPoints V_before = V;
+  const DcrPairResponse out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, W, law, 0.5 * dt)
+                                   : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, w, law, 0.5 * dt);
+  Outcome o;
+  if (!out.active) return o;
+  o.active = true;
+  o.dissipated = out.impulse.dissipated;
+  if (driven) {
+    // The free components' kinetic energy change beyond the dissipation came from the supports.
+    double gained = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int c = 0; c < 3; ++c)
+        if (W(c, i) > 0) gained += 0.5 / W(c, i) * (V(c, i) * V(c, i) - V_before(c, i) * V_before(c, i));
+    o.support_work = gained + out.impulse.dissipated;
+  }
+  for (int i = 0; i < 4; ++i) {
+    const Index n = p.nodes[i];
+    x_new[n] = X_new.col(i);
+    v[n] = V.col(i);
+    moved[n] = stamp;
+  }
+  return o;
+}
+
+/// A round's found pairs (sorted by key) linked on their nodes: per pair and node, the ranks
+/// of the pairs just before and after it on the node; per node (slot), this rank's pairs on
+/// it in key order.
+struct Links {
+  std::vector<std::array<int, 4>> pred, succ;
+  std::vector<Index> offsets, pairs;  ///< CSR over the slots
+  std::vector<Index> nodes;           ///< per slot
+};
+
+Links link_found(std::span<const FoundPair> found, std::span<const DcrKey> keys, DcrRanks* ranks, int me,
+                 std::vector<Index>& slot_of) {
+  Links l;
+  const size_t F = found.size();
+  std::vector<DcrLink> links;
+  links.reserve(4 * F);
+  std::vector<Index> count;
+  for (size_t f = 0; f < F; ++f)
+    for (int c = 0; c < 4; ++c) {
+      const Index n = found[f].pair.nodes[c];
+      if (slot_of[n] < 0) {
+        slot_of[n] = static_cast<Index>(l.nodes.size());
+        l.nodes.push_back(n);
+        count.push_back(0);
+      }
+      ++count[slot_of[n]];
+      links.push_back({static_cast<std::uint64_t>(n), keys[f], me, 4 * f + c});
+    }
+  l.offsets.assign(l.nodes.size() + 1, 0);
+  for (size_t k = 0; k < count.size(); ++k) l.offsets[k + 1] = l.offsets[k] + count[k];
+  l.pairs.resize(l.offsets.back());
+  std::vector<Index> at(l.offsets.begin(), l.offsets.end() - 1);
+  for (size_t f = 0; f < F; ++f)  // ascending f: key order
+    for (const Index n : found[f].pair.nodes) l.pairs[at[slot_of[n]]++] = static_cast<Index>(f);
+  if (ranks) ranks->link(links);
+  else order_links(links);
+  l.pred.resize(F);
+  l.succ.resize(F);
+  for (const DcrLink& k : links) {
+    l.pred[k.tag / 4][k.tag % 4] = k.pred;
+    l.succ[k.tag / 4][k.tag % 4] = k.succ;
+  }
+  return l;
 }
 
 }  // namespace
@@ -61,7 +137,7 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass, double dt,
                            const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           const DcrGather& gather, std::span<const std::uint8_t> held_masks) {
+                           DcrRanks* ranks, std::span<const std::uint8_t> held_masks) {
   const size_t n_nodes = x_new.size();
   SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
                   "resolve_contacts: nodal arrays differ in size (x_new "
@@ -84,9 +160,9 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
   if (surface.surface && !mine.empty()) triangle_normals(*surface.surface, x_old, surface.triangles, tn);
 
   DcrResult result;
-  ContactPairs resolved;  // every pair resolved, with repeats
-  std::vector<double> dissipated, support_work;
-  std::vector<std::uint8_t> active;
+  const int me = ranks ? ranks->rank() : 0;
+  ContactPairs resolved;  // every pair resolved here, with repeats
+  std::vector<Outcome> outcome;
   // The first round's box test keeps the pairs of mine that may touch; later rounds check
   // only those, and only when a node moved in the previous round.
   std::vector<Index>& kept = scratch.overlapping;
@@ -119,79 +195,106 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
       }
     });
     std::vector<FoundPair> found;
+    std::vector<DcrKey> keys;
     if (first_round) kept.clear();
     for (size_t k = 0; k < n_check; ++k) {
       const ContactPair& p = mine[checked(k)];
-      if (hit[k] == 2) found.push_back({p, pair_normals(p, surface, tn)});
+      if (hit[k] == 2) {
+        found.push_back({p, pair_normals(p, surface, tn)});
+        std::array<std::uint64_t, 4> ids;
+        for (int c = 0; c < 4; ++c) ids[c] = ranks ? ranks->id(p.nodes[c]) : static_cast<std::uint64_t>(p.nodes[c]);
+        keys.push_back(dcr_key(p.kind, ids));
+      }
       if (first_round && hit[k] != 3) kept.push_back(checked(k));
       result.detected += hit[k] == 1 || hit[k] == 2;
     }
-    if (gather) gather(found);
     first_round = false;
     ++result.sweeps;
-    if (found.empty()) break;
+    if ((ranks ? ranks->total(static_cast<long>(found.size())) : static_cast<long>(found.size())) == 0) break;
 
-    // Resolution: one Gauss-Seidel pass over the found pairs, color by color.
-    const Coloring colors = color_found(found, scratch.slot);
-    dissipated.assign(found.size(), 0.0);
-    support_work.assign(found.size(), 0.0);
-    active.assign(found.size(), 0);
-    for (int c = 0; c < colors.num_colors(); ++c) {
-      const std::span<const Index> group = colors.items_of(c);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k != r.end(); ++k) {
-          const Index f = group[k];
-          const ContactPair& p = found[f].pair;
-          PairPoints X_old, X_new, V, W;
-          PairWeights w;
-          bool held = false, driven = false;  // a held component; one held at a non-zero velocity
-          for (int i = 0; i < 4; ++i) {
-            const Index n = p.nodes[i];
-            X_old.col(i) = x_old[n];
-            X_new.col(i) = x_new[n];
-            V.col(i) = v[n];
-            w[i] = inv_mass[n];
-            const std::uint8_t h = held_masks.empty() ? 0 : held_masks[n];
-            for (int c = 0; c < 3; ++c) {
-              const bool hc = (h >> c) & 1u;
-              W(c, i) = hc ? 0.0 : w[i];
-              held = held || hc;
-              driven = driven || (hc && V(c, i) != 0.0);
-            }
-          }
-          const PairPoints V_before = V;
-          const PairNormals& N = found[f].normals;
-          const DcrPairResponse out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, W, law, 0.5 * dt)
-                                           : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, N, w, law, 0.5 * dt);
-          if (driven && out.active) {
-            // The free components' kinetic energy change beyond the dissipation came from the supports.
-            double gained = 0;
-            for (int i = 0; i < 4; ++i)
-              for (int c = 0; c < 3; ++c)
-                if (W(c, i) > 0) gained += 0.5 / W(c, i) * (V(c, i) * V(c, i) - V_before(c, i) * V_before(c, i));
-            support_work[f] = gained + out.impulse.dissipated;
-          }
-          if (!out.active) continue;
-          active[f] = 1;
-          dissipated[f] = out.impulse.dissipated;
-          for (int i = 0; i < 4; ++i) {
-            const Index n = p.nodes[i];
-            x_new[n] = X_new.col(i);
-            v[n] = V.col(i);
-            scratch.moved[n] = stamp;
+    // The found pairs in key order, linked on their nodes.
+    {
+      std::vector<size_t> order(found.size());
+      std::iota(order.begin(), order.end(), size_t{0});
+      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return keys[a] < keys[b]; });
+      std::vector<FoundPair> f2(found.size());
+      std::vector<DcrKey> k2(keys.size());
+      for (size_t k = 0; k < order.size(); ++k) f2[k] = found[order[k]], k2[k] = keys[order[k]];
+      found.swap(f2);
+      keys.swap(k2);
+    }
+    const Links links = link_found(found, keys, ranks, me, scratch.slot);
+    const size_t F = found.size();
+    std::vector<int> need(F, 0);
+    for (size_t f = 0; f < F; ++f)
+      for (int c = 0; c < 4; ++c) need[f] += links.pred[f][c] >= 0;
+    std::vector<Index> cursor(links.nodes.size(), 0), ready, batch, last;
+    for (size_t f = 0; f < F; ++f)
+      if (need[f] == 0) ready.push_back(static_cast<Index>(f));
+    // A state from the rank of the pair before on its node: my next pair on the node may go.
+    auto arrived = [&](const std::vector<DcrNodeState>& states) {
+      for (const DcrNodeState& s : states) {
+        x_new[s.node] = s.x_new;
+        v[s.node] = s.v;
+        if (s.moved) scratch.moved[s.node] = stamp;
+        const Index g = scratch.slot[s.node];
+        SHATTER_ASSERT(g >= 0 && cursor[g] < links.offsets[g + 1] - links.offsets[g]);
+        const Index f = links.pairs[links.offsets[g] + cursor[g]];
+        if (--need[f] == 0) ready.push_back(f);
+      }
+    };
+    outcome.assign(F, {});
+    std::map<int, std::vector<DcrNodeState>> posts;
+    for (size_t done = 0; done < F;) {
+      if (ready.empty()) {
+        SHATTER_ASSERT(ranks);
+        arrived(ranks->receive(true));
+        continue;
+      }
+      batch.swap(ready);
+      ready.clear();
+      // The ready pairs share no node (of two pairs on a node, the later waits for the other).
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k)
+          outcome[batch[k]] = resolve_found(found[batch[k]], x_new, x_old, v, inv_mass, held_masks, law, dt,
+                                            scratch.moved, stamp);
+      });
+      for (const Index f : batch) {
+        ++done;
+        for (int c = 0; c < 4; ++c) {
+          const Index n = found[f].pair.nodes[c], g = scratch.slot[n];
+          ++cursor[g];
+          const int succ = links.succ[f][c];
+          const bool moved = scratch.moved[n] == stamp;
+          if (succ == me) {
+            const Index next = links.pairs[links.offsets[g] + cursor[g]];
+            if (--need[next] == 0) ready.push_back(next);
+          } else if (succ >= 0) {
+            posts[succ].push_back({n, x_new[n], v[n], moved});
+          } else if (moved) {
+            last.push_back(n);
           }
         }
-      });
+      }
+      for (auto& [r, states] : posts) ranks->post(r, states);
+      posts.clear();
+      if (ranks) arrived(ranks->receive(false));
     }
-    for (size_t f = 0; f < found.size(); ++f)
-      if (active[f]) {
+    for (const Index n : links.nodes) scratch.slot[n] = -1;
+    if (ranks)
+      for (const Index n : ranks->settle(last, x_new, v)) scratch.moved[n] = stamp;
+    for (size_t f = 0; f < F; ++f)
+      if (outcome[f].active) {
         resolved.push_back(found[f].pair);
-        result.dissipated += dissipated[f];
-        result.support_work += support_work[f];
+        result.dissipated += outcome[f].dissipated;
+        result.support_work += outcome[f].support_work;
       }
     if (result.sweeps == options.max_sweeps) {
       result.capped = true;
-      result.unresolved = found.front().pair;
+      if (!found.empty())
+        result.unresolved = std::min_element(found.begin(), found.end(), [](const FoundPair& a, const FoundPair& b) {
+                              return a.pair < b.pair;
+                            })->pair;
       break;
     }
   }

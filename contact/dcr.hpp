@@ -2,20 +2,23 @@
 // DCR over all candidate pairs of a step: the decomposition contact response of
 // Cirak & West, "Decomposition contact response (DCR) for explicit finite element
 // dynamics", IJNME 64 (2005) 1078-1110. The per-pair physics is in kernels/dcr.hpp;
-// this module finds the penetrating pairs (a read-only, parallel detection that MPI
-// ranks divide among themselves) and resolves them Gauss-Seidel fashion over colored
-// pairs: the colors in order, the pairs of one color (which share no node) in a
-// tbb::parallel_for. Every node receives its updates in the fixed order (round,
-// color, pair), so results are bitwise identical for any number of threads and ranks.
+// this module finds the penetrating pairs (a read-only, parallel detection) and
+// resolves them Gauss-Seidel fashion in the order of contact/dcr_order.hpp: on each
+// node the pairs sharing it in key order, pairs with no common node in parallel
+// (threads) or on different MPI ranks. Every pair is detected and resolved by the
+// rank that owns it; the states of shared nodes pass from rank to rank along each
+// node's list (DcrRanks). Every node receives its updates in the same order on any
+// number of threads and ranks, so the results are bitwise identical.
 #include <cstdint>
-#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
 
+#include "contact/dcr_order.hpp"
 #include "contact/pairs.hpp"
 #include "contact/surface.hpp"
 #include "kernels/dcr.hpp"
+#include "kernels/exact_sum.hpp"
 
 namespace shatter {
 
@@ -30,13 +33,15 @@ struct DcrOptions {
 
 /// Summary of one call of resolve_contacts.
 struct DcrResult {
+  // On several ranks contacts, dissipated, support_work, unresolved and detected are this
+  // rank's part (its pairs); sweeps and capped are the same on every rank.
   Index contacts = 0;       ///< distinct pairs resolved in the step (history "contacts")
   int sweeps = 0;           ///< rounds run, the last one (which found nothing, unless capped) included
-  double dissipated = 0.0;  ///< kinetic energy lost by the impacts and friction, J
+  ExactSum dissipated;      ///< kinetic energy lost by the impacts and friction, J
   /// The work of the conditions that hold components moving at a non-zero velocity on the
   /// pairs, through the impulses (the kinetic energy the free components gained beyond the
-  /// dissipation), J; 0 when every held component is at rest (summed in pair order).
-  double support_work = 0.0;
+  /// dissipation), J; 0 when every held component is at rest.
+  ExactSum support_work;
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
   std::optional<ContactPair> unresolved;  ///< when capped: the first pair (canonical order) found in the last round
   Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds
@@ -49,16 +54,46 @@ struct FoundPair {
   PairNormals normals;
 };
 
-/// Hands the pairs one rank found penetrating in a round to every rank: `found` (this rank's,
-/// in the order of its pairs) is replaced by the union over the ranks in canonical pair order,
-/// and the states x_old, x_new, v of their nodes, as the finders hold them, are written into
-/// the arrays resolve_contacts works on. Empty on one rank.
-using DcrGather = std::function<void(std::vector<FoundPair>& found)>;
+/// A node's state as it passes between ranks during a resolution round.
+struct DcrNodeState {
+  Index node = 0;  ///< mesh node id (this rank's)
+  Vec3 x_new, v;
+  bool moved = false;  ///< a pair moved the node in this round (this or an earlier one on the node)
+};
+
+/// The other ranks' part in resolve_contacts (runtime/patch_ranks.hpp; none on one rank).
+/// Each found pair is resolved by the rank that found it; on each of its nodes it waits
+/// for the pair just before it in the node's list (the rank that resolved that one posts
+/// the node's state), and then posts the state to the rank of the pair just after it.
+class DcrRanks {
+ public:
+  virtual ~DcrRanks() = default;
+  virtual int rank() const = 0;
+  /// The node's whole-model id (the pairs' keys are made of them).
+  virtual std::uint64_t id(Index node) const = 0;
+  /// The sum of count over the ranks (collective).
+  virtual long total(long count) = 0;
+  /// Orders this rank's links (node = mesh node id, rank = rank()) with every rank's, as
+  /// order_links would the union: pred and succ are set (the order of `links` may change;
+  /// collective).
+  virtual void link(std::vector<DcrLink>& links) = 0;
+  /// Sends the states to rank r (nonblocking: they are copied).
+  virtual void post(int r, std::span<const DcrNodeState> states) = 0;
+  /// The states other ranks posted here (node ids are this rank's): with wait, at least one;
+  /// without, those that have arrived.
+  virtual std::vector<DcrNodeState> receive(bool wait) = 0;
+  /// Ends a round's posts: waits until they are sent. Then brings the final states of the
+  /// nodes that moved in the round to every rank that reads them (their volume owners and
+  /// the ranks whose patches hold them): `last` lists the moved nodes whose last pair was
+  /// resolved here. Writes the states received into x_new and v and returns their nodes
+  /// (collective).
+  virtual std::vector<Index> settle(std::span<const Index> last, std::span<Vec3> x_new, std::span<Vec3> v) = 0;
+};
 
 /// Per-node bookkeeping kept between calls, so that a call costs O(pairs), not O(mesh nodes).
 struct DcrScratch {
   std::vector<long> moved;  ///< per node: the last round stamp in which a pair moved it
-  std::vector<Index> slot;  ///< per node: -1 (the coloring's compact numbering, reset after use)
+  std::vector<Index> slot;  ///< per node: -1 (a round's compact numbering of the found pairs' nodes, reset after use)
   long stamp = 0;           ///< rounds started so far, over all calls
   std::vector<Index> overlapping;  ///< out: the pairs of mine (indices) whose swept boxes overlap (last call)
   TriangleNormals normals;         ///< the triangle normals at x_old (DcrSurface::triangles of them)
@@ -95,20 +130,20 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 ///      boxes overlap (pair_boxes_overlap: the pairs a fresh search would give, kept in
 ///      scratch.overlapping) is checked by dcr_detect; in later rounds each of those with a
 ///      node moved in the previous round (the others would be found clean again);
-///   2. the pairs found penetrating on every rank (gather), in canonical order, are colored
-///      greedily in that order (pairs of one color share no node);
-///   3. resolution: one Gauss-Seidel pass over the found pairs, color after color, the pairs of
-///      one color in parallel, each re-detected at its turn and resolved by dcr_resolve_pair.
-/// Rounds repeat until a detection finds nothing; when round options.max_sweeps still finds
-/// pairs, they are resolved and the result is capped. Every rank resolves the same pairs in
-/// the same order from the same states (the gather brings them), so the result is the same
-/// bits on every rank and for any thread count, and every rank ends with the final states of
-/// every node a pair moved. The dissipation is summed per round in pair order. Pairs whose
-/// four nodes are not distinct are skipped. Run inside the caller's tbb::task_arena to choose
-/// the thread count.
+///   2. the pairs found are linked on their nodes in key order (dcr_order.hpp; with ranks,
+///      over all ranks' pairs);
+///   3. resolution: each found pair, once the pairs before it on its nodes are resolved, is
+///      re-detected and resolved by dcr_resolve_pair; the pairs ready together run in parallel.
+///      With ranks, the states of a node pass from the rank of one pair on it to the next's.
+/// Rounds repeat until a detection finds nothing on any rank; when round options.max_sweeps
+/// still finds pairs, they are resolved and the result is capped. The result is that of one
+/// rank and one thread resolving the found pairs one by one in key order, bit for bit. With
+/// ranks, each node a pair moved ends with its final state on every rank that reads it
+/// (DcrRanks::settle). Pairs whose four nodes are not distinct are skipped. Run inside the
+/// caller's tbb::task_arena to choose the thread count.
 DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass,
                            double dt, const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           const DcrGather& gather = {}, std::span<const std::uint8_t> held = {});
+                           DcrRanks* ranks = nullptr, std::span<const std::uint8_t> held = {});
 
 }  // namespace shatter

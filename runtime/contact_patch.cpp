@@ -44,8 +44,15 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
                            Index num_nodes)
     : dec_(dec), surface_(surface), around_(around), num_nodes_(num_nodes) {
-  for (const Index n : surface.vertices)
+  for (const Index n : surface.vertices) {
+    const std::span<const int> ranks = dec.node_ranks(n);
+    if (!std::binary_search(ranks.begin(), ranks.end(), dec.rank())) continue;
+    for (const int r : ranks)
+      if (r != dec.rank()) touching_.push_back(r);
     if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
+  }
+  std::sort(touching_.begin(), touching_.end());
+  touching_.erase(std::unique(touching_.begin(), touching_.end()), touching_.end());
 }
 
 ContactPatch::~ContactPatch() = default;
@@ -157,6 +164,26 @@ void ContactPatch::plan(const std::vector<Index>& nodes) {
   for (int r = 0; r < ranks; ++r)
     for (const Index k : asked[r]) send[r].push_back(surface_.vertices[k]);
   halo_ = std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+  neighbors_ = touching_;
+  for (const auto* plan : {&send, &receive})
+    for (const auto& [r, list] : *plan) neighbors_.push_back(r);
+  std::sort(neighbors_.begin(), neighbors_.end());
+  neighbors_.erase(std::unique(neighbors_.begin(), neighbors_.end()), neighbors_.end());
+  // Each home node's readers: the ranks it is sent to, and the other ranks touching it.
+  const auto& home = volume_vertices_.vertices;
+  std::vector<std::vector<int>> readers(home.size());
+  for (const auto& [r, list] : send)
+    for (const Index n : list) readers[std::lower_bound(home.begin(), home.end(), n) - home.begin()].push_back(r);
+  reader_offsets_.assign(1, 0);
+  readers_.clear();
+  for (size_t k = 0; k < home.size(); ++k) {
+    for (const int r : dec_.node_ranks(home[k]))
+      if (r != me) readers[k].push_back(r);
+    std::sort(readers[k].begin(), readers[k].end());
+    readers[k].erase(std::unique(readers[k].begin(), readers[k].end()), readers[k].end());
+    readers_.insert(readers_.end(), readers[k].begin(), readers[k].end());
+    reader_offsets_.push_back(static_cast<Index>(readers_.size()));
+  }
 }
 
 void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
@@ -165,49 +192,12 @@ void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::s
   halo_->update_ghosts(arrays);
 }
 
-long ContactPatch::share_found(std::vector<FoundPair>& found, std::span<Vec3> x_old, std::span<Vec3> x_new,
-                               std::span<Vec3> v) const {
-  // A rank's part: the counts of its pairs and of their distinct nodes; per pair its kind,
-  // the surface positions of its 4 nodes and its normals (6); per node its surface position
-  // and x_old, x_new, v (9). Integers travel exactly as doubles.
-  constexpr size_t kPair = 1 + 4 + 6, kNode = 1 + 9;
-  std::vector<Index> nodes;
-  for (const FoundPair& f : found) nodes.insert(nodes.end(), f.pair.nodes.begin(), f.pair.nodes.end());
-  sort_unique(nodes);
-  std::vector<double> out;
-  out.reserve(2 + kPair * found.size() + kNode * nodes.size());
-  out.push_back(static_cast<double>(found.size()));
-  out.push_back(static_cast<double>(nodes.size()));
-  for (const FoundPair& f : found) {
-    out.push_back(f.pair.kind);
-    for (const Index n : f.pair.nodes) out.push_back(around_.position[n]);
-    out.insert(out.end(), f.normals.data(), f.normals.data() + 6);
-  }
-  for (const Index n : nodes) {
-    out.push_back(around_.position[n]);
-    for (const auto* a : {&x_old, &x_new, &v}) out.insert(out.end(), (*a)[n].data(), (*a)[n].data() + 3);
-  }
-  const std::vector<double> all = dec_.allgather(out);
-  found.clear();
-  for (size_t at = 0; at < all.size();) {
-    const auto pairs = static_cast<size_t>(all[at]), count = static_cast<size_t>(all[at + 1]);
-    at += 2;
-    for (size_t p = 0; p < pairs; ++p, at += kPair) {
-      FoundPair f;
-      f.pair.kind = static_cast<ContactPair::Kind>(all[at]);
-      for (int c = 0; c < 4; ++c) f.pair.nodes[c] = surface_.vertices[static_cast<Index>(all[at + 1 + c])];
-      std::copy_n(&all[at + 5], 6, f.normals.data());
-      found.push_back(f);
-    }
-    for (size_t k = 0; k < count; ++k, at += kNode) {
-      const Index n = surface_.vertices[static_cast<Index>(all[at])];
-      x_old[n] = Vec3(all[at + 1], all[at + 2], all[at + 3]);
-      x_new[n] = Vec3(all[at + 4], all[at + 5], all[at + 6]);
-      v[n] = Vec3(all[at + 7], all[at + 8], all[at + 9]);
-    }
-  }
-  std::sort(found.begin(), found.end(), [](const FoundPair& a, const FoundPair& b) { return a.pair < b.pair; });
-  return static_cast<long>(sizeof(double) * out.size()) * (dec_.size() - 1);
+std::span<const int> ContactPatch::readers(Index node) const {
+  const auto& home = volume_vertices_.vertices;
+  const auto it = std::lower_bound(home.begin(), home.end(), node);
+  SHATTER_ASSERT(it != home.end() && *it == node);
+  const auto k = it - home.begin();
+  return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
 }
 
 long ContactPatch::exchange_bytes() const { return halo_ ? static_cast<long>(halo_->update_bytes(9)) : 0; }

@@ -68,11 +68,12 @@ class ContactPatch {
   /// Bytes this rank sends per exchange().
   long exchange_bytes() const;
 
-  /// DcrGather on several ranks: this rank's pairs found penetrating (with their normals and
-  /// the states of their nodes) to every rank; `found` becomes the union in canonical pair
-  /// order and the states are written into the arrays. Returns the bytes this rank sent.
-  long share_found(std::vector<FoundPair>& found, std::span<Vec3> x_old, std::span<Vec3> x_new,
-                   std::span<Vec3> v) const;
+  /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
+  /// states to or receives states from each step, and those touching a surface node with it.
+  std::span<const int> neighbors() const { return neighbors_; }
+  /// For a surface node whose volume owner this rank is: the other ranks that read its
+  /// state (their patches hold it, or they touch it), ascending.
+  std::span<const int> readers(Index node) const;
 
  private:
   /// Plan the exchange of `nodes` (ascending mesh ids) from their owners (collective).
@@ -89,6 +90,10 @@ class ContactPatch {
   std::vector<Index> normal_triangles_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
   std::unique_ptr<Halo> halo_;
+  std::vector<int> touching_;   ///< the ranks touching a surface node with this one
+  std::vector<int> neighbors_;  ///< touching_ and the plan's ranks
+  std::vector<Index> reader_offsets_;  ///< CSR over volume_vertices_.vertices
+  std::vector<int> readers_;
 };
 
 }  // namespace shatter

@@ -2,8 +2,6 @@
 
 #include <tbb/parallel_reduce.h>
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <numeric>
@@ -14,21 +12,12 @@
 #include "runtime/contact_patch.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/parallel.hpp"
+#include "runtime/patch_ranks.hpp"
+#include "runtime/timed.hpp"
 
 namespace shatter {
 
-namespace {
-
-/// This thread's CPU time, s.
-double cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-}  // namespace
-
-ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const Decomposition* dec) {
+ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const Decomposition* dec) : model_(model) {
   if (dec && dec->distributed()) {
     dec_ = dec;
     partition_ = std::make_unique<ContactPartition>(dec->comm());
@@ -97,7 +86,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   std::sort(triangle_order_.begin(), triangle_order_.end(), [&](Index a, Index b) {
     return std::pair(surface_.triangles[a], a) < std::pair(surface_.triangles[b], b);
   });
+  ranks_.reset();
   patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, mesh.num_nodes());
+  ranks_ = std::make_unique<PatchRanks>(*patch_, surface_, vertex_triangles_, model_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
@@ -126,10 +117,10 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   if (dec_) {
     search_patch(x_old, x_new, v);
   } else {
-    const double cpu0 = cpu_seconds();
+    const double cpu0 = thread_cpu_seconds();
     pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_));
     std::erase_if(pairs_, [&](const ContactPair& p) { return excluded(p); });
-    profile_.search_cpu_seconds += cpu_seconds() - cpu0;
+    profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
   }
   x_search_.assign(x_new.begin(), x_new.end());
   have_candidates_ = true;
@@ -172,7 +163,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     }
     patch_->reach(x_old, x_new, margin_);
     exchange(x_old, x_new, v);
-    const double cpu0 = cpu_seconds();
+    const double cpu0 = thread_cpu_seconds();
     const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_));
     // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
     pairs_.clear();
@@ -196,7 +187,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
       pairs_.push_back(p);
       weight_[q] += 1.0f;
     }
-    profile_.search_cpu_seconds += cpu_seconds() - cpu0;
+    profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
     const long mine = static_cast<long>(pairs_.size());
     const long most = dec_->max(mine), total = dec_->sum(std::vector<long>{mine})[0];
     if (repartitioned || most * dec_->size() <= 1.1 * static_cast<double>(total)) break;
@@ -238,6 +229,30 @@ ContactBalance ContactStage::balance() const {
   return b;
 }
 
+std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine,
+                                                          std::span<Vec3> x) const {
+  // Each rank's first pair (kind, surface positions of its nodes, their positions) to every rank.
+  constexpr size_t kWords = 5 + 12;
+  std::vector<double> out;
+  if (mine) {
+    out.push_back(mine->kind);
+    for (const Index n : mine->nodes) out.push_back(vertex_triangles_.position[n]);
+    for (const Index n : mine->nodes) out.insert(out.end(), x[n].data(), x[n].data() + 3);
+  }
+  const std::vector<double> all = dec_->allgather(out);
+  std::optional<ContactPair> first;
+  size_t at_first = 0;
+  for (size_t at = 0; at < all.size(); at += kWords) {
+    ContactPair p{static_cast<ContactPair::Kind>(all[at]), {}};
+    for (int c = 0; c < 4; ++c) p.nodes[c] = surface_.vertices[static_cast<Index>(all[at + 1 + c])];
+    if (!first || p < *first) first = p, at_first = at;
+  }
+  // Its nodes' positions here too, for the diagnosis.
+  if (first)
+    for (int c = 0; c < 4; ++c) x[first->nodes[c]] = Vec3(all[at_first + 5 + 3 * c], all[at_first + 6 + 3 * c], all[at_first + 7 + 3 * c]);
+  return first;
+}
+
 ContactPairs ContactStage::active_pairs() const {
   const std::vector<Index>& kept = scratch_.overlapping;
   ContactPairs out(kept.size());
@@ -260,26 +275,23 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new, v);
   lap(profile_.search_seconds);
-  DcrGather gather;
   DcrSurface surface{&surface_, &vertex_triangles_};
-  const double cpu0 = cpu_seconds();
-  double gather_cpu = 0;
+  if (dec_) surface.triangles = patch_->normal_triangles();
+  const double cpu0 = thread_cpu_seconds();
+  const long bytes0 = dec_ ? ranks_->bytes() : 0;
+  const double wait0 = dec_ ? ranks_->seconds() : 0, wait_cpu0 = dec_ ? ranks_->cpu_seconds() : 0;
+  DcrResult r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, ranks_.get(), held);
+  double wait_cpu = 0;
   if (dec_) {
-    surface.triangles = patch_->normal_triangles();
-    gather = [&](std::vector<FoundPair>& found) {
-      const double gather0 = cpu_seconds();
-      const auto t0 = clock::now();
-      const long bytes = patch_->share_found(found, x_old, x_new, v);
-      profile_.exchange_bytes += bytes;
-      profile_.found_bytes += bytes;
-      profile_.exchange_seconds += std::chrono::duration<double>(clock::now() - t0).count();
-      gather_cpu += cpu_seconds() - gather0;
-    };
+    const long bytes = ranks_->bytes() - bytes0;
+    profile_.exchange_bytes += bytes;
+    profile_.found_bytes += bytes;
+    profile_.exchange_seconds += ranks_->seconds() - wait0;
+    wait_cpu = ranks_->cpu_seconds() - wait_cpu0;
+    if (r.capped) r.unresolved = first_unresolved(r.unresolved, x_new);
   }
-  const DcrResult r =
-      resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, gather, held);
   lap(profile_.sweep_seconds);
-  profile_.sweep_cpu_seconds += cpu_seconds() - cpu0 - gather_cpu;
+  profile_.sweep_cpu_seconds += thread_cpu_seconds() - cpu0 - wait_cpu;
   ++profile_.steps;
   profile_.candidates += static_cast<long>(pairs_.size());
   profile_.owned_pairs += static_cast<long>(scratch_.overlapping.size());

@@ -19,14 +19,14 @@
 // patch of the surface (ContactPatch): its own primitives, the ghosts whose
 // boxes reach them, and the states of their nodes, which the volume owners
 // send point to point each step. A pair belongs to the rank of its face
-// (vertex-face) or first edge (edge-edge); each rank searches and detects its
-// patch only. The few pairs found penetrating travel to every rank with the
-// states of their nodes, and every rank resolves all of them in the same order
-// (resolve_contacts): every rank ends with the serial bits of every node a pair
-// moved.
+// (vertex-face) or first edge (edge-edge); each rank searches, detects and
+// resolves its patch's pairs only, and the states of nodes that pairs on
+// several ranks share pass between those ranks (PatchRanks): every node a pair
+// moved ends with the one-rank bits on every rank that reads it.
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -51,7 +51,7 @@ struct ContactProfile {
   // On several ranks:
   long exchange_bytes = 0;      ///< bytes this rank sent: state_bytes + found_bytes
   long state_bytes = 0;         ///< its nodes' states to the patches that hold them
-  long found_bytes = 0;         ///< the pairs it found penetrating, with their nodes' states
+  long found_bytes = 0;         ///< DCR's: its found pairs' links and the states passed on (PatchRanks)
   double exchange_seconds = 0;  ///< in those gathers (not in the times above)
   long repartitions = 0;        ///< RCB partitions computed
   // Thread CPU time of the work itself (meaningful when ranks share cores):
@@ -70,6 +70,7 @@ struct ContactBalance {
 class Decomposition;
 class ContactPartition;
 class ContactPatch;
+class PatchRanks;
 
 class ContactStage {
  public:
@@ -83,7 +84,10 @@ class ContactStage {
   /// held (empty: none): per node, bit k = component k held (resolve_contacts).
   /// On several ranks the arrays' owned entries are the state; the patch's other
   /// nodes (x_old too) are filled from their owners, and every node a pair moved
-  /// gets its final state on every rank.
+  /// gets its final state on every rank that touches it or holds it in its patch.
+  /// The result's contacts, dissipated and support_work are then this rank's part;
+  /// when capped, unresolved is the first pair over all ranks (and its nodes' x_new
+  /// are written here).
   DcrResult apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                   std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {});
 
@@ -126,11 +130,15 @@ class ContactStage {
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
   void search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
+  /// On several ranks: the first (canonical order) of every rank's `mine`; its nodes' x
+  /// from the rank that found it are written into x (collective).
+  std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine, std::span<Vec3> x) const;
   /// The RCB partition of the owned primitives at x, weighted by their candidates.
   std::vector<int> partition(std::span<const Vec3> x);
   /// The patch's nodes' states from their owners (timed and counted as exchange).
   void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
 
+  const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
   DcrOptions options_;
@@ -148,6 +156,7 @@ class ContactStage {
   const Decomposition* dec_ = nullptr;  ///< null on one rank
   std::unique_ptr<ContactPartition> partition_;
   std::unique_ptr<ContactPatch> patch_;  ///< of surface_
+  std::unique_ptr<PatchRanks> ranks_;    ///< DCR's exchanges between the patches
   std::vector<Index> triangle_order_;    ///< triangles sorted by their nodes (pair -> face)
   std::vector<float> weight_;            ///< per triangle, then edge: candidates at the last search (owned ones)
   bool repartition_ = true;              ///< partition at the next search

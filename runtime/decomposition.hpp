@@ -102,6 +102,12 @@ class Decomposition {
   bool owns_element(Index e) const { return owns_granule(model_.whole_element(e) / ElementForces::kGranule); }
   /// The rank owning element e (held here).
   int element_rank(Index e) const { return granule_rank_[model_.whole_element(e) / ElementForces::kGranule]; }
+  /// The ranks touching the node, ascending (empty on one rank).
+  std::span<const int> node_ranks(Index node) const {
+    if (size_ == 1) return {};
+    return {node_ranks_.data() + node_rank_offsets_[node],
+            static_cast<size_t>(node_rank_offsets_[node + 1] - node_rank_offsets_[node])};
+  }
   /// The smallest rank touching the node.
   int node_owner(Index node) const { return size_ == 1 ? 0 : node_ranks_[node_rank_offsets_[node]]; }
   Index owned_elements() const { return owned_elements_; }

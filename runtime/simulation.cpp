@@ -54,6 +54,7 @@ Simulation::Simulation(Model& model, RunOptions options)
   f_ext_.assign(n, Vec3::Zero());
   if (model_.scene.contact) {
     contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
+    count_contact_vertices();
   }
   node_arrays_from_model();
   reaction_.assign(bc_nodes_.size(), Vec3::Zero());
@@ -230,7 +231,7 @@ void Simulation::predict() {
 
 void Simulation::resolve_contact() {
   // On several ranks the contact stage brings its patch's states from their owners.
-  const std::vector<Index>& vertices = contact_->surface().vertices;
+  const std::vector<Index>& vertices = contact_vertices_;
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
   for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
@@ -239,9 +240,9 @@ void Simulation::resolve_contact() {
     contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
     contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
   }
-  ledger_.contacts = r.contacts;
-  ledger_.contact_dissipated += r.dissipated;
-  ledger_.external_work += r.support_work;
+  step_work_[kContactDissipated] += r.dissipated;
+  step_work_[kSupportWork] += r.support_work;
+  step_work_[kContactsResolved] += static_cast<double>(r.contacts);
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
       throw Error(sweep_cap_diagnosis(model_, x_, r, step_ + 1, time_ + dt_));
@@ -268,10 +269,10 @@ void Simulation::book_contact_work() {
   // energy besides the impulses' kinetic-energy loss, to first order: -f(n+1) . (dx - dt/2 dv)
   // (docs/contact.md, "The ledger with e < 1"); booked as contact_work, whatever the law.
   const double half = 0.5 * dt_;
-  const std::vector<Index>& vertices = contact_->surface().vertices;
+  const std::vector<Index>& vertices = contact_vertices_;
   for (size_t k = 0; k < vertices.size(); ++k) {
     const Index i = vertices[k];
-    if (dec_->owns_node(i) && (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero()))
+    if (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero())
       step_work_[kContactWork] += (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
   }
 }
@@ -321,6 +322,13 @@ void Simulation::rebuild_contact_surface() {
   // (kernels/cohesive.hpp), and with DCR on the coincident faces and the edges of
   // the crack mouth too the two fought (the sweep cap reached).
   contact_->rebuild(model_.mesh, fracture_->bonded_faces(), fracture_->bonded_twins());
+  count_contact_vertices();
+}
+
+void Simulation::count_contact_vertices() {
+  contact_vertices_.clear();
+  for (const Index i : contact_->surface().vertices)
+    if (dec_->owns_node(i)) contact_vertices_.push_back(i);
 }
 
 void Simulation::share_plans() {
@@ -394,9 +402,13 @@ void Simulation::update_ledger() {
   ledger_.strain = t[kStrain].value();
   ledger_.cohesive_stored = t[kStored].value();
   ledger_.cohesive_dissipated = t[kDissipated].value();
-  ledger_.external_work +=
-      t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value() + t[kLocal + kLoadWork].value();
+  ledger_.external_work += t[kLocal + kGravityWork].value() + t[kLocal + kReactionWork].value() +
+                           t[kLocal + kLoadWork].value() + t[kLocal + kSupportWork].value();
   ledger_.contact_work += t[kLocal + kContactWork].value();
+  if (contact_) {
+    ledger_.contact_dissipated += t[kLocal + kContactDissipated].value();
+    ledger_.contacts = static_cast<long>(t[kLocal + kContactsResolved].value());
+  }
   // Energy errors are relative to the largest energy the model has held.
   energy_scale_ = std::max(energy_scale_, ledger_.kinetic + ledger_.strain + ledger_.cohesive_stored +
                                               std::abs(ledger_.external_work));

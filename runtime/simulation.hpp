@@ -182,10 +182,20 @@ class Simulation {
   /// The step to take next: time.dt, or the step controller's; shortened to land on time.end.
   double next_dt();
 
-  /// The step's work terms, exact sums over this rank's owned nodes, summed
-  /// over the ranks by update_ledger: gravity's work, the reactions' work and
-  /// the contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work).
-  enum StepWork { kGravityWork, kReactionWork, kContactWork, kLoadWork, kStepWorks };
+  /// The step's terms, exact sums over this rank's owned nodes and pairs, summed
+  /// over the ranks by update_ledger: gravity's work, the reactions' work, the
+  /// contact's f(n+1) . (dx - dt/2 dv) (Ledger::contact_work), the loads' work,
+  /// and DCR's dissipation, supports' work and number of pairs resolved.
+  enum StepWork {
+    kGravityWork,
+    kReactionWork,
+    kContactWork,
+    kLoadWork,
+    kContactDissipated,
+    kSupportWork,
+    kContactsResolved,
+    kStepWorks
+  };
   /// Accumulators of update_ledger's one reduction per step: kinetic energy,
   /// momentum (3), angular momentum (3), strain, cohesive stored and
   /// dissipated, and the step's works.
@@ -201,6 +211,8 @@ class Simulation {
   void share_plans();
   /// The contact surface of the cracked mesh, without the bonded cohesive facets' faces.
   void rebuild_contact_surface();
+  /// contact_vertices_ from the surface and the node ownership.
+  void count_contact_vertices();
   std::vector<Vec3> x_, v_, a_, f_int_, f_ext_;
   std::vector<double> inv_mass_;
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
@@ -219,8 +231,9 @@ class Simulation {
   double total0_ = 0, energy_scale_ = 0;
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)
+  std::vector<Index> contact_vertices_;  ///< the contact surface's vertices this rank owns (owns_node)
   std::vector<Vec3> contact_dx_,
-      contact_dv_;  ///< per contact surface vertex: the step's contact change of x(n+1), v(n+1/2)
+      contact_dv_;  ///< per contact_vertices_: the step's contact change of x(n+1), v(n+1/2)
   std::unique_ptr<FractureStage> fracture_;  ///< null without a fracture block
   std::vector<double> stress6_;             ///< per element Cauchy stress for the facet check (fracture only)
   CohesiveEnergy cohesive_energy_;          ///< of the cohesive elements owned here, at the last forces
