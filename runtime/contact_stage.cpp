@@ -216,15 +216,17 @@ std::vector<int> ContactStage::partition(std::span<const Vec3> x) {
 
 ContactBalance ContactStage::balance() const {
   const ContactProfile& p = profile_;
-  ContactBalance b{p.owned_pairs, p.owned_pairs, p.owned_pairs, p.candidates, p.state_bytes, p.found_bytes,
-                   p.search_cpu_seconds, p.sweep_cpu_seconds};
+  ContactBalance b{p.owned_pairs,     p.owned_pairs, p.owned_pairs,        p.candidates,
+                   p.states_posted,   p.state_bytes, p.found_bytes,        p.search_cpu_seconds,
+                   p.sweep_cpu_seconds};
   if (dec_) {
-    long most[4] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max}, sum[2] = {b.pairs_sum, b.candidates_sum};
+    long most[4] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max},
+         sum[3] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum};
     double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
     MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_LONG, MPI_MAX, dec_->comm());
-    MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPI_LONG, MPI_SUM, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_LONG, MPI_SUM, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
-    b = {-most[0], most[1], sum[0], sum[1], most[2], most[3], cpu[0], cpu[1]};
+    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1]};
   }
   return b;
 }
@@ -278,7 +280,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   DcrSurface surface{&surface_, &vertex_triangles_};
   if (dec_) surface.triangles = patch_->normal_triangles();
   const double cpu0 = thread_cpu_seconds();
-  const long bytes0 = dec_ ? ranks_->bytes() : 0;
+  const long bytes0 = dec_ ? ranks_->bytes() : 0, posted0 = dec_ ? ranks_->posted() : 0;
   const double wait0 = dec_ ? ranks_->seconds() : 0, wait_cpu0 = dec_ ? ranks_->cpu_seconds() : 0;
   DcrResult r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, ranks_.get(), held);
   double wait_cpu = 0;
@@ -286,6 +288,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     const long bytes = ranks_->bytes() - bytes0;
     profile_.exchange_bytes += bytes;
     profile_.found_bytes += bytes;
+    profile_.states_posted += ranks_->posted() - posted0;
     profile_.exchange_seconds += ranks_->seconds() - wait0;
     wait_cpu = ranks_->cpu_seconds() - wait_cpu0;
     if (r.capped) r.unresolved = first_unresolved(r.unresolved, x_new);

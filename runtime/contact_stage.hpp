@@ -52,6 +52,7 @@ struct ContactProfile {
   long exchange_bytes = 0;      ///< bytes this rank sent: state_bytes + found_bytes
   long state_bytes = 0;         ///< its nodes' states to the patches that hold them
   long found_bytes = 0;         ///< DCR's: its found pairs' links and the states passed on (PatchRanks)
+  long states_posted = 0;       ///< node states passed to the rank of the node's next pair
   double exchange_seconds = 0;  ///< in those gathers (not in the times above)
   long repartitions = 0;        ///< RCB partitions computed
   // Thread CPU time of the work itself (meaningful when ranks share cores):
@@ -63,6 +64,7 @@ struct ContactProfile {
 struct ContactBalance {
   long pairs_min = 0, pairs_max = 0, pairs_sum = 0;  ///< ContactProfile::owned_pairs
   long candidates_sum = 0;
+  long states_posted_sum = 0;  ///< ContactProfile::states_posted
   long state_bytes_max = 0, found_bytes_max = 0;
   double search_cpu_max = 0, sweep_cpu_max = 0;
 };

@@ -128,6 +128,7 @@ void PatchRanks::post(int r, std::span<const DcrNodeState> states) {
     requests_.emplace_back();
     MPI_Isend(w.data(), static_cast<int>(w.size()), MPI_UINT64_T, r, kPost, comm_, &requests_.back());
     bytes_ += static_cast<long>(sizeof(std::uint64_t) * w.size());
+    posted_ += static_cast<long>(states.size());
   });
 }
 

@@ -44,6 +44,8 @@ class PatchRanks final : public DcrRanks {
 
   /// Bytes this rank sent so far (links, posts and settles).
   long bytes() const { return bytes_; }
+  /// Node states this rank posted so far (to the rank of a node's next pair).
+  long posted() const { return posted_; }
   /// Wall and CPU seconds spent in the calls above so far (the messages' waits included).
   double seconds() const { return seconds_; }
   double cpu_seconds() const { return cpu_seconds_; }
@@ -65,7 +67,7 @@ class PatchRanks final : public DcrRanks {
   int rank_ = 0;
   std::vector<Words> sending_;  ///< posts in flight
   std::vector<MPI_Request> requests_;
-  long bytes_ = 0;
+  long bytes_ = 0, posted_ = 0;
   double seconds_ = 0, cpu_seconds_ = 0;
 };
 

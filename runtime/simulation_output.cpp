@@ -246,6 +246,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
       j.add("contact_exchange_bytes_per_step", cp.exchange_bytes / steps);
       j.add("contact_state_bytes_per_step_max", contact_balance.state_bytes_max / steps);
       j.add("contact_found_bytes_per_step_max", contact_balance.found_bytes_max / steps);
+      j.add("contact_states_passed", contact_balance.states_posted_sum);
       j.add("contact_search_cpu_time_max", contact_balance.search_cpu_max);
       j.add("contact_dcr_cpu_time_max", contact_balance.sweep_cpu_max);
       j.add("contact_repartitions", cp.repartitions);

@@ -6,7 +6,8 @@
 # decomposition, so the flag changes nothing). Also checks that summary.json
 # names the ranks, that `shatter check` says the same on 1 and 3 ranks, and
 # that the comparison covers what the scene is for:
-#   contact:  the run had contacts, and at 3 ranks every rank resolved pairs;
+#   contact:  the run had contacts, and at 3 ranks every rank resolved pairs and
+#             some pairs waited for a pair on another rank sharing a node;
 #   fracture: cohesive elements were inserted between elements of different
 #             ranks at 3 ranks (cracks crossing subdomain boundaries);
 #   volume:   (no contact, no fracture) at 3 ranks each rank held only its
@@ -56,6 +57,10 @@ if [ "$kind" = contact ]; then
   least=$(grep -o '"contact_pairs_per_step_rank_min": [-0-9.e+]*' "$work/r3t1/summary.json" | awk '{print $2}')
   awk -v m="${least:-0}" 'BEGIN { exit !(m > 0) }' || { echo "FAIL: a rank of 3 resolved no contact pairs"; status=1; }
   what="$what, at 3 ranks at least $least pairs per step per rank"
+  # Pairs on different ranks shared nodes, so states passed between them (PatchRanks).
+  passed=$(grep -o '"contact_states_passed": [0-9]*' "$work/r3t1/summary.json" | awk '{print $2}')
+  awk -v m="${passed:-0}" 'BEGIN { exit !(m > 0) }' || { echo "FAIL: at 3 ranks no pair waited for one on another rank"; status=1; }
+  what="$what, $passed states passed between ranks"
 elif [ "$kind" = volume ]; then
   bytes() { grep -o '"model_bytes_per_rank_max": [0-9]*' "$work/$1/summary.json" | grep -o '[0-9]*$'; }
   one=$(bytes r1t1) three=$(bytes r3t1)
