@@ -203,7 +203,7 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
         found.push_back({p, pair_normals(p, surface, tn)});
         std::array<std::uint64_t, 4> ids;
         for (int c = 0; c < 4; ++c) ids[c] = ranks ? ranks->id(p.nodes[c]) : static_cast<std::uint64_t>(p.nodes[c]);
-        keys.push_back(dcr_key(p.kind, ids));
+        keys.push_back(dcr_key(p.kind, ids, result.sweeps));
       }
       if (first_round && hit[k] != 3) kept.push_back(checked(k));
       result.detected += hit[k] == 1 || hit[k] == 2;

@@ -16,8 +16,8 @@ std::uint64_t mix(std::uint64_t z) {
 
 }  // namespace
 
-DcrKey dcr_key(ContactPair::Kind kind, const std::array<std::uint64_t, 4>& ids) {
-  std::uint64_t h = mix(kind + 1);
+DcrKey dcr_key(ContactPair::Kind kind, const std::array<std::uint64_t, 4>& ids, int round) {
+  std::uint64_t h = mix((static_cast<std::uint64_t>(round) << 1 | kind) + 1);
   for (const std::uint64_t id : ids) h = mix(h ^ (id + 0x9e3779b97f4a7c15ULL));
   return {h, kind, ids};
 }

@@ -1,8 +1,10 @@
 #pragma once
 // The order in which DCR resolves the pairs found penetrating in a round
 // (docs/contact.md "The order of resolution"). Each pair has a priority key,
-// a hash of its nodes' whole-model ids (ties, which are rare, broken by the
-// ids themselves). On every node the pairs that share it are resolved one
+// a hash of its nodes' whole-model ids and of the round's number (ties,
+// which are rare, broken by the ids themselves). The order changes from
+// round to round because one fixed order can cycle: a few pairs that undo
+// each other found again in every round until the cap. On every node the pairs that share it are resolved one
 // after the other in key order, and pairs with no common node in any order:
 // the result is that of a Gauss-Seidel pass over the found pairs sorted by
 // key, whatever the ranks, threads and grouping (Jones & Plassmann, "A
@@ -27,8 +29,9 @@ struct DcrKey {
   friend auto operator<=>(const DcrKey&, const DcrKey&) = default;
 };
 
-/// The key of a pair of the given kind whose nodes have the whole-model ids `ids`.
-DcrKey dcr_key(ContactPair::Kind kind, const std::array<std::uint64_t, 4>& ids);
+/// The key of a pair of the given kind whose nodes have the whole-model ids `ids`, in
+/// round `round` of a step's resolution (the order changes from round to round).
+DcrKey dcr_key(ContactPair::Kind kind, const std::array<std::uint64_t, 4>& ids, int round);
 
 /// One node of one found pair: a place in that node's list of found pairs.
 struct DcrLink {

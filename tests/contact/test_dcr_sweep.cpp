@@ -312,7 +312,7 @@ TEST(DcrSweep, ResolutionIsAOneByOnePassInKeyOrder) {
       if (dcr_detect(kind, X_old, X_new, pair_normals(p, surface.dcr(), tn)).penetrating) {
         std::array<std::uint64_t, 4> ids;
         for (int c = 0; c < 4; ++c) ids[c] = static_cast<std::uint64_t>(p.nodes[c]);
-        found.emplace_back(dcr_key(p.kind, ids), p);
+        found.emplace_back(dcr_key(p.kind, ids, rounds - 1), p);
       }
     }
     if (found.empty()) break;
