@@ -80,7 +80,8 @@ void ContactPatch::own(std::vector<int> primitive_rank) {
   add_nodes<3>(owned_.triangles, owned_.vertices);
   add_nodes<2>(owned_.edges, owned_.vertices);
   sort_unique(owned_.vertices);
-  plan(owned_.vertices);
+  whole_ = plan(owned_.vertices);
+  active_.reset();
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
@@ -118,19 +119,26 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_.body = owned_.body;
   for (const Index e : edges) patch_.edges.push_back(surface_.edges[e]);
   for (const Index k : vertices) patch_.vertices.push_back(surface_.vertices[k]);
-  // The triangles around every node of the patch's primitives orient its pairs; their
-  // nodes are planned (marks kept between searches, cleared after use).
+  std::vector<Index> needed;
+  add_nodes<3>(patch_.triangles, needed);
+  add_nodes<2>(patch_.edges, needed);
+  needed.insert(needed.end(), patch_.vertices.begin(), patch_.vertices.end());
+  sort_unique(needed);
+  whole_ = plan(needed);
+  active_.reset();
+}
+
+void ContactPatch::activate(std::span<const ContactPair> pairs) {
+  // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
+  // (marks kept between searches, cleared after use).
   triangle_mark_.resize(surface_.triangles.size(), 0);
   node_mark_.resize(num_nodes_, 0);
   std::vector<Index> needed;
   auto add = [&](Index n) {
     if (!node_mark_[n]) node_mark_[n] = 1, needed.push_back(n);
   };
-  for (const Index n : patch_.vertices) add(n);
-  for (const auto& t : patch_.triangles)
-    for (const Index n : t) add(n);
-  for (const auto& e : patch_.edges)
-    for (const Index n : e) add(n);
+  for (const ContactPair& p : pairs)
+    for (const Index n : p.nodes) add(n);
   normal_triangles_.clear();
   for (size_t k = 0, nodes = needed.size(); k < nodes; ++k) {
     const Index p = around_.position[needed[k]];
@@ -146,10 +154,10 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (const Index n : needed) node_mark_[n] = 0;
   std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::sort(needed.begin(), needed.end());
-  plan(needed);
+  active_ = plan(needed);
 }
 
-void ContactPatch::plan(const std::vector<Index>& nodes) {
+std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
   const int ranks = dec_.size(), me = dec_.rank();
   std::map<int, std::vector<Index>> receive;
   std::vector<std::vector<Index>> requests(ranks);
@@ -163,7 +171,7 @@ void ContactPatch::plan(const std::vector<Index>& nodes) {
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
     for (const Index k : asked[r]) send[r].push_back(surface_.vertices[k]);
-  halo_ = std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+  auto halo = std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
   neighbors_ = touching_;
   for (const auto* plan : {&send, &receive})
     for (const auto& [r, list] : *plan) neighbors_.push_back(r);
@@ -184,12 +192,16 @@ void ContactPatch::plan(const std::vector<Index>& nodes) {
     readers_.insert(readers_.end(), readers[k].begin(), readers[k].end());
     reader_offsets_.push_back(static_cast<Index>(readers_.size()));
   }
+  return halo;
 }
 
-void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
-  if (!halo_) return;
+Halo* ContactPatch::halo(bool whole) const { return whole || !active_ ? whole_.get() : active_.get(); }
+
+void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole) {
+  Halo* h = halo(whole);
+  if (!h) return;
   const std::span<Vec3> arrays[] = {x_old, x_new, v};
-  halo_->update_ghosts(arrays);
+  h->update_ghosts(arrays);
 }
 
 std::span<const int> ContactPatch::readers(Index node) const {
@@ -200,6 +212,9 @@ std::span<const int> ContactPatch::readers(Index node) const {
   return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
 }
 
-long ContactPatch::exchange_bytes() const { return halo_ ? static_cast<long>(halo_->update_bytes(9)) : 0; }
+long ContactPatch::exchange_bytes(bool whole) const {
+  const Halo* h = halo(whole);
+  return h ? static_cast<long>(h->update_bytes(9)) : 0;
+}
 
 }  // namespace shatter

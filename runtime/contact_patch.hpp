@@ -2,9 +2,11 @@
 // A rank's share of the contact surface on several MPI ranks (docs/parallel.md
 // "Contact across ranks"): the triangles and edges it owns (a partition of the
 // surface primitives, ContactPartition), the ghost primitives whose boxes reach
-// into the box of its own, and the plan that brings the states of their nodes
-// from the volume owners, point to point, once per step. The search and the
-// detection run on the patch only; no surface state goes to every rank.
+// into the box of its own, and two plans that bring the states of nodes from
+// their volume owners, point to point: the whole patch's (for a search) and,
+// between searches, the nodes of this rank's candidate pairs and the
+// triangles around them only (every step). The search and DCR run on the
+// patch only; no surface state goes to every rank.
 //
 // The surface's topology (triangles, edges, the vertex -> triangle lists) is
 // still held on every rank: memory that grows with the surface, no traffic.
@@ -40,7 +42,7 @@ class ContactPatch {
   ContactPatch& operator=(const ContactPatch&) = delete;
 
   /// A new ownership: the rank of each triangle, then of each edge (the same array on every
-  /// rank). Plans the states of the owned primitives' nodes (collective).
+  /// rank). Plans the states of the owned primitives' nodes as the whole patch (collective).
   void own(std::vector<int> primitive_rank);
   bool owned_any() const { return !primitive_rank_.empty(); }
   const std::vector<int>& primitive_rank() const { return primitive_rank_; }
@@ -54,30 +56,39 @@ class ContactPatch {
   /// primitives' inflated boxes) is gathered; the owner of each edge sends it to the ranks
   /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
   /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
-  /// reach here; the plan brings the nodes of the triangles around their nodes (the normals
-  /// that orient the pairs). Collective.
+  /// reach here; their nodes are the whole patch's plan (no active plan until activate()).
+  /// Collective.
   void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
+  /// The active plan, until the next search: the nodes of `pairs` (this rank's candidates)
+  /// and of the triangles around them, whose normals orient the pairs. Collective.
+  void activate(std::span<const ContactPair> pairs);
   /// The surface the search runs on here (surface order, node ids of the mesh).
   const ContactSurface& patch() const { return patch_; }
-  /// The triangles whose normals the pairs of the patch read, ascending.
+  /// The triangles whose normals the active pairs read, ascending.
   std::span<const Index> normal_triangles() const { return normal_triangles_; }
+  /// The surface vertices whose volume owner this rank is, ascending.
+  std::span<const Index> home_vertices() const { return volume_vertices_.vertices; }
 
-  /// The volume owners' x_old, x_new and v of the planned nodes into the arrays
-  /// (point to point; collective in the plan's ranks). No-op before own().
-  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
-  /// Bytes this rank sends per exchange().
-  long exchange_bytes() const;
+  /// The volume owners' x_old, x_new and v of the planned nodes into the arrays: the whole
+  /// patch's, or the active plan's (the whole patch's before activate()). Point to point;
+  /// collective in the plan's ranks. No-op before own().
+  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole);
+  /// Bytes this rank sends per exchange(..., whole).
+  long exchange_bytes(bool whole) const;
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
-  /// states to or receives states from each step, and those touching a surface node with it.
+  /// states to or receives states from in the last plan (the active one after a search), and
+  /// those touching a surface node with it.
   std::span<const int> neighbors() const { return neighbors_; }
   /// For a surface node whose volume owner this rank is: the other ranks that read its
   /// state (their patches hold it, or they touch it), ascending.
   std::span<const int> readers(Index node) const;
 
  private:
-  /// Plan the exchange of `nodes` (ascending mesh ids) from their owners (collective).
-  void plan(const std::vector<Index>& nodes);
+  /// Plans the exchange of `nodes` (ascending mesh ids) from their owners and makes it the
+  /// source of neighbors() and readers() (collective).
+  std::unique_ptr<Halo> plan(const std::vector<Index>& nodes);
+  Halo* halo(bool whole) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
@@ -89,7 +100,7 @@ class ContactPatch {
   ContactSurface owned_, patch_;
   std::vector<Index> normal_triangles_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
-  std::unique_ptr<Halo> halo_;
+  std::unique_ptr<Halo> whole_, active_;
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks
   std::vector<Index> reader_offsets_;  ///< CSR over volume_vertices_.vertices

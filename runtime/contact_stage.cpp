@@ -97,8 +97,8 @@ ContactStage::~ContactStage() = default;
 
 bool ContactStage::candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const {
   if (!have_candidates_) return false;
-  // On several ranks each checks its patch's vertices (every primitive's nodes are in its owner's).
-  const auto& vertices = dec_ ? patch_->patch().vertices : surface_.vertices;
+  // On several ranks each checks the surface vertices whose volume owner it is.
+  const std::span<const Index> vertices = dec_ ? patch_->home_vertices() : std::span<const Index>(surface_.vertices);
   const bool valid = tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, vertices.size(), 4096), true,
       [&](const tbb::blocked_range<size_t>& r, bool valid) {
@@ -127,11 +127,11 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   ++profile_.searches;
 }
 
-void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
+void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole) {
   const auto t0 = std::chrono::steady_clock::now();
-  patch_->exchange(x_old, x_new, v);
-  profile_.exchange_bytes += patch_->exchange_bytes();
-  profile_.state_bytes += patch_->exchange_bytes();
+  patch_->exchange(x_old, x_new, v, whole);
+  profile_.exchange_bytes += patch_->exchange_bytes(whole);
+  profile_.state_bytes += patch_->exchange_bytes(whole);
   profile_.exchange_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -152,17 +152,18 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     for (size_t q = 0; q < first_owner.size(); ++q)
       first_owner[q] = dec_->node_owner(static_cast<Index>(q) < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]);
     patch_->own(std::move(first_owner));
-    exchange(x_old, x_new, v);
   }
+  // The whole patch's states (between searches only the active nodes' came).
+  exchange(x_old, x_new, v, true);
   for (bool repartitioned = false;; repartitioned = true) {
     if (repartition_) {
       patch_->own(partition(x_new));
-      exchange(x_old, x_new, v);
+      exchange(x_old, x_new, v, true);
       repartition_ = false;
       ++profile_.repartitions;
     }
     patch_->reach(x_old, x_new, margin_);
-    exchange(x_old, x_new, v);
+    exchange(x_old, x_new, v, true);
     const double cpu0 = thread_cpu_seconds();
     const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_));
     // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
@@ -193,6 +194,8 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     if (repartitioned || most * dec_->size() <= 1.1 * static_cast<double>(total)) break;
     repartition_ = true;
   }
+  patch_->activate(pairs_);
+  exchange(x_old, x_new, v, false);
 }
 
 std::vector<int> ContactStage::partition(std::span<const Vec3> x) {
@@ -272,7 +275,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     last = now;
     exchanged = profile_.exchange_seconds;
   };
-  if (dec_) exchange(x_old, x_new, v);
+  if (dec_) exchange(x_old, x_new, v, false);
   const bool valid = candidates_valid(x_old, x_new);
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new, v);
