@@ -80,8 +80,8 @@ void ContactPatch::own(std::vector<int> primitive_rank) {
   add_nodes<3>(owned_.triangles, owned_.vertices);
   add_nodes<2>(owned_.edges, owned_.vertices);
   sort_unique(owned_.vertices);
-  whole_ = plan(owned_.vertices);
-  active_.reset();
+  for (auto& p : plans_) p.reset();
+  plans_[static_cast<int>(PatchPlan::Owned)] = plan(owned_.vertices);
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
@@ -124,8 +124,8 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   add_nodes<2>(patch_.edges, needed);
   needed.insert(needed.end(), patch_.vertices.begin(), patch_.vertices.end());
   sort_unique(needed);
-  whole_ = plan(needed);
-  active_.reset();
+  plans_[static_cast<int>(PatchPlan::Patch)] = plan(needed);
+  plans_[static_cast<int>(PatchPlan::Active)].reset();
 }
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
@@ -154,7 +154,7 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (const Index n : needed) node_mark_[n] = 0;
   std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::sort(needed.begin(), needed.end());
-  active_ = plan(needed);
+  plans_[static_cast<int>(PatchPlan::Active)] = plan(needed);
 }
 
 std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
@@ -195,10 +195,10 @@ std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
   return halo;
 }
 
-Halo* ContactPatch::halo(bool whole) const { return whole || !active_ ? whole_.get() : active_.get(); }
+Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
-void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole) {
-  Halo* h = halo(whole);
+void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
+  Halo* h = halo(plan);
   if (!h) return;
   const std::span<Vec3> arrays[] = {x_old, x_new, v};
   h->update_ghosts(arrays);
@@ -212,8 +212,8 @@ std::span<const int> ContactPatch::readers(Index node) const {
   return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
 }
 
-long ContactPatch::exchange_bytes(bool whole) const {
-  const Halo* h = halo(whole);
+long ContactPatch::exchange_bytes(PatchPlan plan) const {
+  const Halo* h = halo(plan);
   return h ? static_cast<long>(h->update_bytes(9)) : 0;
 }
 

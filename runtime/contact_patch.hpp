@@ -2,10 +2,11 @@
 // A rank's share of the contact surface on several MPI ranks (docs/parallel.md
 // "Contact across ranks"): the triangles and edges it owns (a partition of the
 // surface primitives, ContactPartition), the ghost primitives whose boxes reach
-// into the box of its own, and two plans that bring the states of nodes from
-// their volume owners, point to point: the whole patch's (for a search) and,
+// into the box of its own, and three plans that bring the states of nodes
+// from their volume owners, point to point: the owned primitives' (their
+// boxes start a search), the whole patch's (the search) and, every step
 // between searches, the nodes of this rank's candidate pairs and the
-// triangles around them only (every step). The search and DCR run on the
+// triangles around them only. The search and DCR run on the
 // patch only; no surface state goes to every rank.
 //
 // The surface's topology (triangles, edges, the vertex -> triangle lists) is
@@ -30,6 +31,10 @@ class Halo;
 SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
                           double margin);
 
+/// Which nodes' states ContactPatch::exchange brings: the owned primitives' (own()), the
+/// patch's (reach()) or the candidates' (activate()).
+enum class PatchPlan { Owned, Patch, Active };
+
 class ContactPatch {
  public:
   /// surface, around: the contact surface and its vertex -> triangle lists, held by the
@@ -42,7 +47,7 @@ class ContactPatch {
   ContactPatch& operator=(const ContactPatch&) = delete;
 
   /// A new ownership: the rank of each triangle, then of each edge (the same array on every
-  /// rank). Plans the states of the owned primitives' nodes as the whole patch (collective).
+  /// rank). Plans the states of the owned primitives' nodes (PatchPlan::Owned; collective).
   void own(std::vector<int> primitive_rank);
   bool owned_any() const { return !primitive_rank_.empty(); }
   const std::vector<int>& primitive_rank() const { return primitive_rank_; }
@@ -56,10 +61,9 @@ class ContactPatch {
   /// primitives' inflated boxes) is gathered; the owner of each edge sends it to the ranks
   /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
   /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
-  /// reach here; their nodes are the whole patch's plan (no active plan until activate()).
-  /// Collective.
+  /// reach here; their nodes are PatchPlan::Patch. Collective.
   void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
-  /// The active plan, until the next search: the nodes of `pairs` (this rank's candidates)
+  /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates)
   /// and of the triangles around them, whose normals orient the pairs. Collective.
   void activate(std::span<const ContactPair> pairs);
   /// The surface the search runs on here (surface order, node ids of the mesh).
@@ -69,12 +73,11 @@ class ContactPatch {
   /// The surface vertices whose volume owner this rank is, ascending.
   std::span<const Index> home_vertices() const { return volume_vertices_.vertices; }
 
-  /// The volume owners' x_old, x_new and v of the planned nodes into the arrays: the whole
-  /// patch's, or the active plan's (the whole patch's before activate()). Point to point;
-  /// collective in the plan's ranks. No-op before own().
-  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole);
-  /// Bytes this rank sends per exchange(..., whole).
-  long exchange_bytes(bool whole) const;
+  /// The volume owners' x_old, x_new and v of the plan's nodes into the arrays. Point to
+  /// point; collective in the plan's ranks. No-op before the plan is made.
+  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
+  /// Bytes this rank sends per exchange(..., plan).
+  long exchange_bytes(PatchPlan plan) const;
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
   /// states to or receives states from in the last plan (the active one after a search), and
@@ -88,7 +91,7 @@ class ContactPatch {
   /// Plans the exchange of `nodes` (ascending mesh ids) from their owners and makes it the
   /// source of neighbors() and readers() (collective).
   std::unique_ptr<Halo> plan(const std::vector<Index>& nodes);
-  Halo* halo(bool whole) const;
+  Halo* halo(PatchPlan plan) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
@@ -100,7 +103,7 @@ class ContactPatch {
   ContactSurface owned_, patch_;
   std::vector<Index> normal_triangles_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
-  std::unique_ptr<Halo> whole_, active_;
+  std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks
   std::vector<Index> reader_offsets_;  ///< CSR over volume_vertices_.vertices

@@ -127,11 +127,11 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   ++profile_.searches;
 }
 
-void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole) {
+void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
   const auto t0 = std::chrono::steady_clock::now();
-  patch_->exchange(x_old, x_new, v, whole);
-  profile_.exchange_bytes += patch_->exchange_bytes(whole);
-  profile_.state_bytes += patch_->exchange_bytes(whole);
+  patch_->exchange(x_old, x_new, v, plan);
+  profile_.exchange_bytes += patch_->exchange_bytes(plan);
+  profile_.state_bytes += patch_->exchange_bytes(plan);
   profile_.exchange_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -153,17 +153,17 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
       first_owner[q] = dec_->node_owner(static_cast<Index>(q) < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]);
     patch_->own(std::move(first_owner));
   }
-  // The whole patch's states (between searches only the active nodes' came).
-  exchange(x_old, x_new, v, true);
+  // The owned primitives' states start the search (their boxes, the reach).
+  exchange(x_old, x_new, v, PatchPlan::Owned);
   for (bool repartitioned = false;; repartitioned = true) {
     if (repartition_) {
       patch_->own(partition(x_new));
-      exchange(x_old, x_new, v, true);
+      exchange(x_old, x_new, v, PatchPlan::Owned);
       repartition_ = false;
       ++profile_.repartitions;
     }
     patch_->reach(x_old, x_new, margin_);
-    exchange(x_old, x_new, v, true);
+    exchange(x_old, x_new, v, PatchPlan::Patch);
     const double cpu0 = thread_cpu_seconds();
     const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_));
     // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
@@ -195,7 +195,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     repartition_ = true;
   }
   patch_->activate(pairs_);
-  exchange(x_old, x_new, v, false);
+  exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
 std::vector<int> ContactStage::partition(std::span<const Vec3> x) {
@@ -275,8 +275,10 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     last = now;
     exchanged = profile_.exchange_seconds;
   };
-  if (dec_) exchange(x_old, x_new, v, false);
+  // The reuse check reads the owned surface vertices; the candidates' states come after it
+  // (a search brings them itself).
   const bool valid = candidates_valid(x_old, x_new);
+  if (dec_ && valid) exchange(x_old, x_new, v, PatchPlan::Active);
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new, v);
   lap(profile_.search_seconds);

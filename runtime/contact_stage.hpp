@@ -72,6 +72,7 @@ struct ContactBalance {
 class Decomposition;
 class ContactPartition;
 class ContactPatch;
+enum class PatchPlan;
 class PatchRanks;
 
 class ContactStage {
@@ -137,9 +138,9 @@ class ContactStage {
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine, std::span<Vec3> x) const;
   /// The RCB partition of the owned primitives at x, weighted by their candidates.
   std::vector<int> partition(std::span<const Vec3> x);
-  /// The patch's nodes' states from their owners, the whole patch's or the active ones
-  /// (ContactPatch::exchange; timed and counted as exchange).
-  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, bool whole);
+  /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
+  /// counted as exchange).
+  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
 
   const Model& model_;
   ContactSurface surface_;
