@@ -7,12 +7,14 @@
 #       REPEATS runs each (default 5), interleaved; medians of the loop wall time.
 #   SCENE=FILE bench/mpi_scaling.sh BUILD strong 0 [REPEATS]
 #       the same on the scene FILE as it is (e.g. scenes/cubes76.yaml).
-#   [FIRST=R0] bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
+#   [FIRST=R0] [SET=key=value] bench/mpi_scaling.sh BUILD weak [PER_RANK] [MAX_RANKS]
 #       R = R0 (default 1), 2 R0, 4 R0, ... MAX_RANKS (default 64, oversubscribed) with PER_RANK
 #       tets per rank (default 2000), to 2e-4 s (the boxes meet after 5e-5 s):
 #       balance of elements and contact pairs and bytes per rank per step from
 #       summary.json; of the times, only the contact's thread CPU times per
-#       step (the largest rank's) mean something when oversubscribed.
+#       step (the largest rank's) mean something when oversubscribed. SET adds one
+#       --set to every run (e.g. SET=contact.self=false), and results go to
+#       mpi_scaling_weak_<key>.csv.
 #   bench/mpi_scaling.sh BUILD memory [ELEMENTS] [MAX_RANKS]
 #       one box of ELEMENTS tets (default 2000000) on R = 1, 2, 4, ... MAX_RANKS
 #       (default 8) ranks, 20 steps: each rank's peak memory and the bytes of
@@ -150,14 +152,15 @@ elif [ "$mode" = memory ]; then
 else
   per_rank=${3:-2000}
   max_ranks=${4:-64}
-  out="$here/results/mpi_scaling_weak.csv"
+  out="$here/results/mpi_scaling_weak${SET:+_${SET%%=*}}.csv"
+  extra=(); [ -n "${SET:-}" ] && extra=(--set "$SET")
   echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,contact_searches,contact_repartitions,contact_state_bytes_max,contact_found_bytes_max,contact_search_cpu_ms_per_step_max,contact_dcr_cpu_ms_per_step_max" > "$out"
   r=${FIRST:-1}
   while [ "$r" -le "$max_ranks" ]; do
     h=$(size_for $((per_rank * r)))
     dir="$work/weak$r"
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
-      --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h"
+      --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h" "${extra[@]}"
     echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max),$(contact "$dir")" | tee -a "$out"
     r=$((r * 2))
   done

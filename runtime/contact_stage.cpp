@@ -28,6 +28,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   margin_fraction_ = spec.search_margin;
   options_.placement = spec.placement;
   body_pairs_ = spec.pairs;
+  self_ = spec.self;
   // A part of the model brings the whole model's surface.
   if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
   else rebuild(model.mesh);
@@ -55,9 +56,11 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 
 bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
-  if (!body_pairs_.empty()) {
+  if (!body_pairs_.empty() || !self_) {
     const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
-    if (!std::binary_search(body_pairs_.begin(), body_pairs_.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)}))
+    if (!self_ && a == b) return true;
+    if (!body_pairs_.empty() &&
+        !std::binary_search(body_pairs_.begin(), body_pairs_.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)}))
       return true;
   }
   if (twin_of_.empty()) return false;
@@ -79,7 +82,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   }
   have_candidates_ = false;
   pairs_.clear();
-  if (!body_pairs_.empty()) node_body_ = mesh.node_body;
+  if (!body_pairs_.empty() || !self_) node_body_ = mesh.node_body;
   if (!dec_) return;
   triangle_order_.resize(surface_.triangles.size());
   std::iota(triangle_order_.begin(), triangle_order_.end(), 0);

@@ -127,7 +127,8 @@ class ContactStage {
   void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   /// Whether the pair is left out: its primitives share a node, twins counted as one
-  /// (rebuild), or its bodies are not a pair of contact.pairs.
+  /// (rebuild), its bodies are not a pair of contact.pairs, or they are one body and
+  /// contact.self is false.
   bool excluded(const ContactPair& p) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
@@ -152,7 +153,8 @@ class ContactStage {
   ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
   std::vector<Index> twin_of_;  ///< per node, its twins' representative (the smallest id); empty: no twins
   std::vector<std::array<int, 2>> body_pairs_;  ///< contact.pairs (empty: all)
-  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs)
+  bool self_ = true;                            ///< contact.self
+  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;

@@ -602,7 +602,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     ContactSpec cs;
     if (!c.IsNull()) {
       r.only_keys(c, "contact",
-                  {"friction", "restitution", "max_sweeps", "search_margin", "placement", "on_sweep_cap", "pairs"});
+                  {"friction", "restitution", "max_sweeps", "search_margin", "placement", "on_sweep_cap", "pairs", "self"});
       if (const YAML::Node p = c["pairs"]) {
         if (!p.IsSequence() || p.size() == 0) r.fail("contact.pairs", "a list of body name pairs [[a, b], ...]", p);
         for (std::size_t k = 0; k < p.size(); ++k) {
@@ -620,6 +620,15 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
         }
         std::sort(cs.pairs.begin(), cs.pairs.end());
         cs.pairs.erase(std::unique(cs.pairs.begin(), cs.pairs.end()), cs.pairs.end());
+      }
+      if (const YAML::Node self = c["self"]) {
+        if (!self.IsScalar() || (self.Scalar() != "true" && self.Scalar() != "false"))
+          r.fail("contact.self", "true or false", self);
+        cs.self = self.Scalar() == "true";
+        for (const auto& [a, b] : cs.pairs)
+          if (!cs.self && a == b)
+            r.fail("contact.self", "true when contact.pairs lists a body with itself ('" + s.bodies[a].name + "')",
+                   self);
       }
       if (c["friction"]) {
         cs.friction = r.number(c["friction"], "contact.friction");

@@ -82,6 +82,9 @@ struct ContactSpec {
   /// contact.pairs: the body pairs (indices, a <= b; a == b: a body's self-contact) that may
   /// touch, ascending; empty: every pair, self-contact included.
   std::vector<std::array<int, 2>> pairs;
+  /// contact.self: false drops every pair of one body (self-contact, between its own
+  /// fragments too).
+  bool self = true;
 };
 
 struct CheckpointSpec {

@@ -165,6 +165,7 @@ std::string physics_keys(const Scene& s) {
     const DcrPlacement p = c.placement;
     w.text("contact.placement", p == DcrPlacement::End ? "end" : p == DcrPlacement::Middle ? "middle" : "impact");
     w.text("contact.on_sweep_cap", c.sweep_cap_fatal ? "fail" : "warn");
+    w.text("contact.self", c.self ? "true" : "false");
   }
   w.vec3("gravity", s.gravity);
   return w.str();
