@@ -20,9 +20,9 @@ inline constexpr int kLogWidth = 8;
 /// position and N (an aligned fixed-size array of kLogWidth: Eigen's
 /// vectorised loop from the first value to the last), so an element's ln J
 /// has the same bits in a group of 8 and alone (ranks x threads
-/// determinism). 0.95 ns per value at avx512, 1.5 ns at avx2, against 2.0 -
-/// 2.4 ns for glibc's scalar log. Without AVX (SSE, the baseline width:
-/// two doubles per vector) Eigen's packet log takes 3.6 ns per value, so
+/// determinism). 1.0 ns per value at avx512, 1.5 ns at avx2, against 2.5 -
+/// 2.9 ns for glibc's scalar log. Without AVX (SSE, the baseline width:
+/// two doubles per vector) Eigen's packet log takes 3.8 ns per value, so
 /// there it is glibc's std::log, value by value (docs/performance.md, "A
 /// vectorised log"). x <= 0 gives NaN (0: -inf), as std::log.
 template <int N>
