@@ -32,8 +32,8 @@ template <int N>
   for (int l0 = 0; l0 < N; l0 += kLogWidth) {
     Block a;
     for (int l = 0; l < kLogWidth; ++l) a[l] = l0 + l < N ? x[l0 + l] : 1.0;
-    // GCC 12's AVX-512 intrinsics start masked operations from a vector it
-    // then calls uninitialised (_mm512_undefined_pd, GCC bug 105593).
+    // GCC 12 warns that its own AVX-512 intrinsics use an uninitialised
+    // vector (the _mm512_undefined_pd they start masked operations from).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
