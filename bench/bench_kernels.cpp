@@ -15,6 +15,10 @@
 //     baseline), 1 = kernels/tet4.hpp; order 0 = Gmsh order, 1 = after
 //     reorder_for_locality (mesh/reorder.hpp).
 //   * TET10 Neo-Hookean (4-point rule) on a ~70k-element box, same loops.
+//   * ln J of 4 096 values in [0.5, 2) in shuffled order, in L1 (LaneLog/<kernel>):
+//     kernel 0 = glibc's std::log value by value, 1 = lane_log (kernels/lane_log.hpp,
+//     what the lane kernels call), 2 = Eigen's packet log of 8 values (lane_log's
+//     path with AVX; at the baseline width its SSE form, which lane_log does not use).
 // Counters: items_per_second = element-steps/s (all threads);
 //   Melem_per_core = million element-steps/s per thread;
 //   bw_frac = (bytes per element-step x rate) / STREAM triad rate at the same
@@ -42,6 +46,7 @@
 #include <random>
 #include <vector>
 
+#include "kernels/lane_log.hpp"
 #include "kernels/tet10.hpp"
 #include "kernels/tet4.hpp"
 #include "mesh/gmsh_input.hpp"
@@ -363,6 +368,33 @@ void BM_Tet4InCache(benchmark::State& state) {
   state.counters["Melem_per_core"] = benchmark::Counter(kElems * 1e-6 * state.iterations(), benchmark::Counter::kIsRate);
 }
 
+/// ln of 4 096 det F values in [0.5, 2), shuffled (no branch pattern to learn),
+/// in L1: ns per value (docs/performance.md "A vectorised log").
+void BM_LaneLog(benchmark::State& state) {
+  const int kernel = static_cast<int>(state.range(0));
+  constexpr int kValues = 4096;
+  std::vector<double> x(kValues), y(kValues);
+  for (int i = 0; i < kValues; ++i) x[i] = 0.5 + 1.5 * ((i * 2654435761u) % kValues) / kValues;
+  using Block = Eigen::Array<double, 8, 1>;
+  for (auto _ : state) {
+    for (int i = 0; i < kValues; i += 8) {
+      const double(&in)[8] = *reinterpret_cast<const double(*)[8]>(x.data() + i);
+      double(&out)[8] = *reinterpret_cast<double(*)[8]>(y.data() + i);
+      if (kernel == 0) {
+        for (int l = 0; l < 8; ++l) out[l] = std::log(in[l]);
+      } else if (kernel == 1) {
+        lane_log(in, out);
+      } else {
+        const Block r = Eigen::Map<const Block>(in).log();
+        for (int l = 0; l < 8; ++l) out[l] = r[l];
+      }
+    }
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(int64_t{kValues} * state.iterations());
+}
+
 /// Determinism guard, run once: the lane kernel equals the single-element
 /// kernel bitwise, and the colored loop gives bitwise the same forces and
 /// energy on 1 and 2 threads.
@@ -455,6 +487,7 @@ BENCHMARK(BM_Tet4Serial)->ArgNames({"kernel", "morton"})->ArgsProduct({{0, 1, 2,
 // computes it (tet4_stable_length, NeoHookean::wave_speed(J): a second log, 2 sqrt);
 // kernel 6 = lanes + tet4_stable_dt_squared_lanes (no log, no sqrt per element).
 BENCHMARK(BM_Tet4InCache)->ArgName("kernel")->Arg(0)->Arg(1)->Arg(kLanes)->Arg(5)->Arg(6);
+BENCHMARK(BM_LaneLog)->ArgName("kernel")->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(BM_Tet4Determinism)->Iterations(1)->Repetitions(1);
 BENCHMARK(BM_Tet4Colored)
     ->ArgNames({"B", "threads", "morton"})

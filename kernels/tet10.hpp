@@ -10,6 +10,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "kernels/lane_log.hpp"
 #include "kernels/neo_hookean.hpp"
 #include "kernels/tet4.hpp"
 #include "kernels/types.hpp"
@@ -136,7 +137,7 @@ inline void tet10_reference_into_lanes(const Tet10Reference& ref, Tet10Lanes<N>&
 /// operations (as tet4_neo_hookean_lanes), so the compiler vectorises across
 /// elements and every lane is bitwise equal to the one-lane result
 /// (tet10_internal_force with NeoHookean is this function with N = 1). Per
-/// point: F = x dN/dX, cof(F) for det F and F^-T, one log, P = mu F +
+/// point: F = x dN/dX, cof(F) for det F and F^-T, one log (lane_log), P = mu F +
 /// ((lambda ln J - mu) / J) cof(F), f += w P dN/dX^T.
 template <int N>
 inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
@@ -155,7 +156,7 @@ inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
         }
       detF[l] = cofactor_lane(F, C, l);
     }
-    for (int l = 0; l < N; ++l) lnJ[l] = std::log(detF[l]);  // scalar libm calls
+    lane_log(detF, lnJ);
     for (int l = 0; l < N; ++l) {
       double P[9];  // w P, column-major
       L.energy[l] += neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.w[q][l], mat, l, P);

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "kernels/lane_log.hpp"
 #include "kernels/neo_hookean.hpp"
 #include "kernels/types.hpp"
 
@@ -113,12 +114,12 @@ template <int N>
 /// order of operations, so the compiler vectorises across elements (SSE2: 2
 /// lanes) and every lane is bitwise equal to the single-element result
 /// (tet4_internal_force with NeoHookean is this function with N = 1).
-/// ~170 flops and one log per element; no Eigen temporaries, no second
-/// determinant: cof(F) gives both det F and F^-T.
+/// ~170 flops and one log per element (lane_log, across the lanes too); no
+/// Eigen temporaries, no second determinant: cof(F) gives both det F and F^-T.
 template <int N>
 inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
   double F[9][N], C[9][N], detF[N];
-  double* lnJ = L.lnJ;
+  double(&lnJ)[N] = L.lnJ;
   for (int l = 0; l < N; ++l) {
     // Ds columns d[3k + i] = x_{k+1,i} - x_{0,i};  F = Ds Dm^-1, F[3j + i] = F(i, j)
     double d[9];
@@ -130,7 +131,7 @@ inline void tet4_neo_hookean_lanes(Tet4Lanes<N>& L, const NeoHookean& mat) {
                           d[6 + i] * L.Dm_inv[3 * j + 2][l];
     detF[l] = cofactor_lane(F, C, l);
   }
-  for (int l = 0; l < N; ++l) lnJ[l] = std::log(detF[l]);  // scalar libm calls
+  lane_log(detF, lnJ);
   for (int l = 0; l < N; ++l) {
     double P[9];
     L.energy[l] = neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.V0[l], mat, l, P);

@@ -1,7 +1,8 @@
 // TET4 and TET10 kernels: partition of unity, gradients, quadratic exactness,
-// internal force = dE/dx, patch tests, HRZ mass fractions.
+// internal force = dE/dx, patch tests, HRZ mass fractions, lanes = one element.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 
 #include "expect_close.hpp"
@@ -144,4 +145,47 @@ TEST(Tet, AffineMotionGivesUniformStressAndZeroNetForce) {
 TEST(Tet4, MinAltitude) {
   // unit right tetrahedron: altitude to the slanted face = 1/sqrt(3)
   EXPECT_NEAR(tet_min_altitude(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)), 1 / std::sqrt(3.0), 1e-15);
+}
+
+TEST(Tet, LaneKernelsGiveEachElementItsOneElementBits) {
+  // The element loop runs groups of 8 elements through the lane kernels and
+  // the others one by one (runtime/element_forces.cpp): an element's forces,
+  // energy and det F (hence ln J, lane_log) must have the same bits in any
+  // lane as alone, or ranks x threads would change the results. Eight
+  // different deformations, det F from ~0.3 to ~3.
+  constexpr int N = 8;
+  auto same = [](const double* a, const double* b, int n) { return std::memcmp(a, b, n * sizeof(double)) == 0; };
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  const Tet4Reference r4 = tet4_reference(kCorners[0], kCorners[1], kCorners[2], kCorners[3]);
+  const Tet10Nodes X = straight_tet10(kCorners);
+  const Tet10Reference r10 = tet10_reference(X);
+  std::array<Tet10Nodes, N> x;
+  Tet4Lanes<N> L4;
+  Tet10Lanes<N> L10;
+  for (int l = 0; l < N; ++l) {
+    const double s = std::pow(1.45, l - 3);  // volume ratio s^3
+    x[l] = s * X;
+    for (int a = 0; a < 10; ++a) x[l].col(a) += Vec3(u(rng), u(rng), u(rng));
+    for (int q = 0; q < 12; ++q) L4.x[q][l] = x[l].data()[q];
+    for (int q = 0; q < 9; ++q) L4.Dm_inv[q][l] = r4.Dm_inv.data()[q];
+    L4.V0[l] = r4.volume;
+    for (int q = 0; q < 30; ++q) L10.x[q][l] = x[l].data()[q];
+    tet10_reference_into_lanes(r10, L10, l);
+  }
+  tet4_neo_hookean_lanes(L4, kMat);
+  tet10_neo_hookean_lanes(L10, kMat);
+  EXPECT_LT(L4.J[0], 0.5);
+  EXPECT_GT(L4.J[N - 1], 2.0);
+  for (int l = 0; l < N; ++l) {
+    const auto one4 = tet4_internal_force(x[l].col(0), x[l].col(1), x[l].col(2), x[l].col(3), r4.Dm_inv, r4.volume, kMat);
+    double f4[12], f10[30];
+    for (int q = 0; q < 12; ++q) f4[q] = L4.f[q][l];
+    for (int q = 0; q < 30; ++q) f10[q] = L10.f[q][l];
+    EXPECT_TRUE(same(f4, one4.f.data(), 12)) << "TET4 lane " << l;
+    EXPECT_TRUE(same(&L4.energy[l], &one4.energy, 1) && same(&L4.J[l], &one4.J, 1)) << "TET4 lane " << l;
+    const auto one10 = tet10_internal_force(x[l], r10, kMat);
+    EXPECT_TRUE(same(f10, one10.f.data(), 30)) << "TET10 lane " << l;
+    EXPECT_TRUE(same(&L10.energy[l], &one10.energy, 1) && same(&L10.J[l], &one10.J, 1)) << "TET10 lane " << l;
+  }
 }
