@@ -155,6 +155,7 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::sort(needed.begin(), needed.end());
   plans_[static_cast<int>(PatchPlan::Active)] = plan(needed);
+  active_fresh_ = true;
 }
 
 std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
@@ -197,11 +198,15 @@ std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
-void ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
+long ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
   Halo* h = halo(plan);
-  if (!h) return;
-  const std::span<Vec3> arrays[] = {x_old, x_new, v};
+  if (!h) return 0;
+  const bool states_only = plan == PatchPlan::Active && !active_fresh_;
+  if (plan == PatchPlan::Active) active_fresh_ = false;
+  const std::span<Vec3> all[] = {x_old, x_new, v};
+  const std::span<const std::span<Vec3>> arrays = states_only ? std::span(all).subspan(1) : std::span(all);
   h->update_ghosts(arrays);
+  return static_cast<long>(h->update_bytes(3 * static_cast<int>(arrays.size())));
 }
 
 std::span<const int> ContactPatch::readers(Index node) const {
@@ -210,11 +215,6 @@ std::span<const int> ContactPatch::readers(Index node) const {
   SHATTER_ASSERT(it != home.end() && *it == node);
   const auto k = it - home.begin();
   return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
-}
-
-long ContactPatch::exchange_bytes(PatchPlan plan) const {
-  const Halo* h = halo(plan);
-  return h ? static_cast<long>(h->update_bytes(9)) : 0;
 }
 
 }  // namespace shatter

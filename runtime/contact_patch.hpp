@@ -73,11 +73,12 @@ class ContactPatch {
   /// The surface vertices whose volume owner this rank is, ascending.
   std::span<const Index> home_vertices() const { return volume_vertices_.vertices; }
 
-  /// The volume owners' x_old, x_new and v of the plan's nodes into the arrays. Point to
-  /// point; collective in the plan's ranks. No-op before the plan is made.
-  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
-  /// Bytes this rank sends per exchange(..., plan).
-  long exchange_bytes(PatchPlan plan) const;
+  /// The volume owners' x_old, x_new and v of the plan's nodes into the arrays; returns the
+  /// bytes this rank sent. After the first exchange of an active plan, its x_old are not
+  /// sent: a node active in the last step holds here its final x(n+1) of that step (from
+  /// that exchange, or from DCR's settle when a pair moved it), which is this step's x(n).
+  /// Point to point; collective in the plan's ranks. No-op before the plan is made.
+  long exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
   /// states to or receives states from in the last plan (the active one after a search), and
@@ -104,6 +105,7 @@ class ContactPatch {
   std::vector<Index> normal_triangles_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan
+  bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks
   std::vector<Index> reader_offsets_;  ///< CSR over volume_vertices_.vertices

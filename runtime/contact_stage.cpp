@@ -132,9 +132,9 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
 
 void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
   const auto t0 = std::chrono::steady_clock::now();
-  patch_->exchange(x_old, x_new, v, plan);
-  profile_.exchange_bytes += patch_->exchange_bytes(plan);
-  profile_.state_bytes += patch_->exchange_bytes(plan);
+  const long bytes = patch_->exchange(x_old, x_new, v, plan);
+  profile_.exchange_bytes += bytes;
+  profile_.state_bytes += bytes;
   profile_.exchange_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
