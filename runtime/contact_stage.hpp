@@ -86,7 +86,9 @@ class ContactStage {
   /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move;
   /// held (empty: none): per node, bit k = component k held (resolve_contacts).
   /// On several ranks the arrays' owned entries are the state; the patch's other
-  /// nodes (x_old too) are filled from their owners, and every node a pair moved
+  /// nodes are filled from their owners (x_new and v each step; x_old at a search,
+  /// while between searches x_old must be what this rank held as x_new at the end
+  /// of the last step, as the time loop's x(n) is), and every node a pair moved
   /// gets its final state on every rank that touches it or holds it in its patch.
   /// The result's contacts, dissipated and support_work are then this rank's part;
   /// when capped, unresolved is the first pair over all ranks (and its nodes' x_new

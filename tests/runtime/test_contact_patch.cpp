@@ -2,7 +2,9 @@
 // many steps of two bodies moving into each other (one spinning), the pairs
 // the ranks check together are the pairs a search of the whole surface gives,
 // each on exactly one rank, while every rank knows only its own nodes' states
-// (the others are NaN until the patch brings them from their owners).
+// and what the patch brought it (the others' x(n+1) and v are NaN until the
+// patch brings them from their owners; their x(n) is what the rank held as
+// x(n+1) at the end of the last step, as in the time loop).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,7 +48,7 @@ TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
   ContactStage stage(m, ContactSpec{}, &dec);
   const Index n = m.mesh.num_nodes();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<Vec3> x_old = m.mesh.reference, x_new(n), v(n), true_old = x_old, true_new(n);
+  std::vector<Vec3> x_old = m.mesh.reference, x_new(n, Vec3::Constant(nan)), v(n), true_old = x_old, true_new(n);
   const std::vector<double> inv_mass(n, 0.0);  // DCR moves nothing: only the pair lists are compared
   const double step = 0.02 * stage.margin();
   long nonempty = 0;
@@ -59,9 +61,10 @@ TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
                                                           X.x() * std::sin(angle) + X.y() * std::cos(angle), X.z()) +
                                                      shift)
                                               : Vec3(X - shift);
-      // A rank knows the states of the nodes it owns only.
+      // A rank knows the states of the nodes it owns, and x(n) of what it held at the end
+      // of the last step.
       const bool mine = !dec.distributed() || dec.node_owner(i) == dec.rank();
-      x_old[i] = mine ? true_old[i] : Vec3::Constant(nan);
+      x_old[i] = mine ? true_old[i] : x_new[i];
       x_new[i] = mine ? true_new[i] : Vec3::Constant(nan);
       v[i] = mine ? Vec3::Zero() : Vec3::Constant(nan);
     }
