@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "kernels/error.hpp"
 
@@ -129,6 +130,59 @@ class MshScan {
     return v;
   }
 
+  /// The nodes of element `tag`, refused unless each is a tag Gmsh 4.8 can
+  /// look up: it takes node tags as int (GModel::getMeshVertexByTag), and a
+  /// tag at or beyond 2^31, or negative, read memory before its table (a
+  /// segfault, or a node made of whatever was there, which Gmsh then wrote
+  /// into its .msh copy: mesh/mesh_file.cpp).
+  void check_node(long long node, std::uint64_t tag) const {
+    if (node < 1 || static_cast<std::uint64_t>(node) > kMaxNodeTag) bad_node(std::to_string(node), tag);
+  }
+  [[noreturn]] void bad_node(const std::string& node, std::uint64_t tag) const {
+    fail("holds element " + std::to_string(tag) + " naming node " + node + "; expected node tags from 1 to " +
+         std::to_string(kMaxNodeTag));
+  }
+  static constexpr std::uint64_t kMaxNodeTag = 2147483647;  // 2^31 - 1
+
+  /// The `n` node tags of ASCII element `tag`.
+  void node_tokens(std::uint64_t n, std::uint64_t tag, const char* section) {
+    std::string token;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      if (!(in_ >> token)) cut(section);
+      long long node = 0;
+      const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), node);
+      if (ec == std::errc::result_out_of_range) bad_node(token, tag);
+      if (ec != std::errc() || end != token.data() + token.size()) cut(section);
+      check_node(node, tag);
+    }
+  }
+
+  /// `n` binary elements of one block, each its tag, `ntags` tags and
+  /// `nodes` node tags, all of type T; the first one's tag `first` read.
+  template <class T>
+  void node_records(std::uint64_t n, std::uint64_t ntags, std::uint64_t nodes, std::uint64_t first,
+                    const char* section) {
+    const std::uint64_t per = 1 + ntags + nodes;  // words per element
+    const std::streamoff start = in_.tellg();
+    skip(1, sizeof(T) * (per - 1), section);  // refused when past the end, before reading
+    skip(n - 1, sizeof(T) * per, section);
+    in_.seekg(start);
+    std::uint64_t words = n * per - 1, at = 1, tag = first;  // at: the word's place in its element
+    std::vector<T> buffer(std::min<std::uint64_t>(words, 1 << 16));
+    while (words > 0) {
+      const std::uint64_t k = std::min<std::uint64_t>(words, buffer.size());
+      if (!in_.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(sizeof(T) * k))) cut(section);
+      for (std::uint64_t i = 0; i < k; ++i, at = (at + 1) % per) {
+        const T v = swap_ ? swapped(buffer[i]) : buffer[i];
+        if (at == 0)
+          tag = static_cast<std::uint64_t>(v);
+        else if (at > ntags && (v < T(1) || static_cast<std::uint64_t>(v) > kMaxNodeTag))
+          bad_node(std::to_string(v), tag);
+      }
+      words -= k;
+    }
+  }
+
   void skip_tokens(std::uint64_t n, const char* section) {
     std::string token;
     for (std::uint64_t i = 0; i < n; ++i)
@@ -191,14 +245,13 @@ class MshScan {
         if (n == 0) continue;
         const auto tag = get_count<std::int32_t>(s);
         const int nodes = nodes_of(type, tag);
-        skip(1, 4 * (ntags + nodes), s);
-        skip(n - 1, 4 * (1 + ntags + nodes), s);
+        node_records<std::int32_t>(n, ntags, static_cast<std::uint64_t>(nodes), tag, s);
         record(type, n, tag);
         done += n;
       } else {
         const std::uint64_t tag = number(s), type = number(s), ntags = number(s);
         skip_tokens(ntags, s);
-        skip_tokens(nodes_of(type, tag), s);
+        node_tokens(nodes_of(type, tag), tag, s);
         record(type, 1, tag);
         ++done;
       }
@@ -230,11 +283,10 @@ class MshScan {
       const std::uint64_t tag = binary_ ? get<std::uint64_t>(s) : number(s);
       const std::uint64_t nodes = nodes_of(type, tag);
       if (binary_) {
-        skip(1, 8 * nodes, s);
-        skip(n - 1, 8 * (1 + nodes), s);
+        node_records<std::uint64_t>(n, 0, nodes, tag, s);
       } else {
-        skip_tokens(nodes, s);
-        for (std::uint64_t i = 1; i < n; ++i) skip_tokens(1 + nodes, s);
+        node_tokens(nodes, tag, s);
+        for (std::uint64_t i = 1; i < n; ++i) node_tokens(nodes, number(s), s);
       }
       record(type, n, tag);
     }

@@ -22,7 +22,8 @@ struct MshElementType {
 /// ASCII and binary (either byte order), sections walked as Gmsh walks them.
 /// Types in order of first appearance. Throws InputError naming `where` and
 /// the file (as `named`, or `path` when empty) when it is not a .msh file of
-/// those formats, or its sections are cut short or malformed.
+/// those formats, its sections are cut short or malformed, or an element
+/// names a node tag outside 1..2^31-1 (Gmsh 4.8 reads out of bounds).
 std::vector<MshElementType> scan_msh_elements(const std::string& path, const std::string& where,
                                               const std::string& named = "");
 
