@@ -81,7 +81,7 @@ void ContactPatch::own(std::vector<int> primitive_rank) {
   add_nodes<2>(owned_.edges, owned_.vertices);
   sort_unique(owned_.vertices);
   for (auto& p : plans_) p.reset();
-  plans_[static_cast<int>(PatchPlan::Owned)] = plan(owned_.vertices);
+  plans_[static_cast<int>(PatchPlan::Owned)] = plan(owned_.vertices, false);
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
@@ -124,7 +124,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   add_nodes<2>(patch_.edges, needed);
   needed.insert(needed.end(), patch_.vertices.begin(), patch_.vertices.end());
   sort_unique(needed);
-  plans_[static_cast<int>(PatchPlan::Patch)] = plan(needed);
+  plans_[static_cast<int>(PatchPlan::Patch)] = plan(needed, false);
   plans_[static_cast<int>(PatchPlan::Active)].reset();
 }
 
@@ -154,11 +154,11 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (const Index n : needed) node_mark_[n] = 0;
   std::sort(normal_triangles_.begin(), normal_triangles_.end());
   std::sort(needed.begin(), needed.end());
-  plans_[static_cast<int>(PatchPlan::Active)] = plan(needed);
+  plans_[static_cast<int>(PatchPlan::Active)] = plan(needed, true);
   active_fresh_ = true;
 }
 
-std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
+std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {
   const int ranks = dec_.size(), me = dec_.rank();
   std::map<int, std::vector<Index>> receive;
   std::vector<std::vector<Index>> requests(ranks);
@@ -172,7 +172,13 @@ std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
     for (const Index k : asked[r]) send[r].push_back(surface_.vertices[k]);
-  auto halo = std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+  if (readers) find_readers(send, receive);
+  return std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+}
+
+void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,
+                                const std::map<int, std::vector<Index>>& receive) {
+  const int me = dec_.rank();
   neighbors_ = touching_;
   for (const auto* plan : {&send, &receive})
     for (const auto& [r, list] : *plan) neighbors_.push_back(r);
@@ -193,7 +199,6 @@ std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes) {
     readers_.insert(readers_.end(), readers[k].begin(), readers[k].end());
     reader_offsets_.push_back(static_cast<Index>(readers_.size()));
   }
-  return halo;
 }
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
@@ -212,7 +217,7 @@ long ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::s
 std::span<const int> ContactPatch::readers(Index node) const {
   const auto& home = volume_vertices_.vertices;
   const auto it = std::lower_bound(home.begin(), home.end(), node);
-  SHATTER_ASSERT(it != home.end() && *it == node);
+  SHATTER_ASSERT(it != home.end() && *it == node && reader_offsets_.size() == home.size() + 1);
   const auto k = it - home.begin();
   return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
 }

@@ -12,6 +12,7 @@
 // The surface's topology (triangles, edges, the vertex -> triangle lists) is
 // still held on every rank: memory that grows with the surface, no traffic.
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <span>
 #include <vector>
@@ -82,16 +83,19 @@ class ContactPatch {
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
   /// states to or receives states from in the last plan (the active one after a search), and
-  /// those touching a surface node with it.
+  /// those touching a surface node with it. Empty before the first search.
   std::span<const int> neighbors() const { return neighbors_; }
   /// For a surface node whose volume owner this rank is: the other ranks that read its
   /// state (their patches hold it, or they touch it), ascending.
   std::span<const int> readers(Index node) const;
 
  private:
-  /// Plans the exchange of `nodes` (ascending mesh ids) from their owners and makes it the
-  /// source of neighbors() and readers() (collective).
-  std::unique_ptr<Halo> plan(const std::vector<Index>& nodes);
+  /// Plans the exchange of `nodes` (ascending mesh ids) from their owners; with `readers`,
+  /// makes it the source of neighbors() and readers() (collective).
+  std::unique_ptr<Halo> plan(const std::vector<Index>& nodes, bool readers);
+  /// neighbors() and readers() from a plan's lists: the home nodes `send` gives to each rank,
+  /// and the nodes `receive` takes from each.
+  void find_readers(const std::map<int, std::vector<Index>>& send, const std::map<int, std::vector<Index>>& receive);
   Halo* halo(PatchPlan plan) const;
 
   const Decomposition& dec_;

@@ -90,6 +90,10 @@ class Reader {
       fail(key, "an integer >= " + std::to_string(min), n);
     }
   }
+  bool flag(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar() || (n.Scalar() != "true" && n.Scalar() != "false")) fail(key, "true or false", n);
+    return n.Scalar() == "true";
+  }
   std::string string(const YAML::Node& n, const std::string& key) const {
     if (!n.IsScalar() || n.Scalar().empty()) fail(key, "a non-empty string", n);
     return n.as<std::string>();
@@ -531,9 +535,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     if (b["angular_velocity"]) body.angular_velocity = r.vec3(b["angular_velocity"], key + ".angular_velocity");
     if (b["velocity_gradient"]) body.velocity_gradient = r.mat3(b["velocity_gradient"], key + ".velocity_gradient");
     if (const YAML::Node rigid = b["rigid"]) {
-      if (!rigid.IsScalar() || (rigid.Scalar() != "true" && rigid.Scalar() != "false"))
-        r.fail(key + ".rigid", "true or false", rigid);
-      body.rigid = rigid.Scalar() == "true";
+      body.rigid = r.flag(rigid, key + ".rigid");
       if (body.rigid && (body.angular_velocity != Vec3::Zero() || body.velocity_gradient))
         r.fail(key + ".rigid",
                "false with angular_velocity or velocity_gradient (a rigid body translates; rotation is not built yet)",
@@ -622,9 +624,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
         cs.pairs.erase(std::unique(cs.pairs.begin(), cs.pairs.end()), cs.pairs.end());
       }
       if (const YAML::Node self = c["self"]) {
-        if (!self.IsScalar() || (self.Scalar() != "true" && self.Scalar() != "false"))
-          r.fail("contact.self", "true or false", self);
-        cs.self = self.Scalar() == "true";
+        cs.self = r.flag(self, "contact.self");
         for (const auto& [a, b] : cs.pairs)
           if (!cs.self && a == b)
             r.fail("contact.self", "true when contact.pairs lists a body with itself ('" + s.bodies[a].name + "')",
