@@ -99,12 +99,17 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     std::iota(local_elements_.begin(), local_elements_.end(), 0);
     return;
   }
-  if (model_.is_part()) {
+  if (model_.is_part() && !model_.holds_two_layers()) {
     // A ghost-only node's star is not whole here: its ranks come from the start-up rank.
     node_rank_offsets_ = model_.part.node_rank_offsets;
     node_ranks_ = model_.part.node_ranks;
   } else {
-    NodeRanks touch = granule_touching_ranks(mesh, granule_rank_);
+    // From the stars: with two layers, every node of a held element is whole
+    // here, so its ranks are right (after splits too); the outer layer's own
+    // nodes get only some of theirs, and are never read.
+    std::vector<int> elem_part(ne);
+    for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[model_.whole_element(e) / ElementForces::kGranule];
+    NodeRanks touch = touching_ranks(mesh, elem_part);
     node_rank_offsets_ = std::move(touch.offsets);
     node_ranks_ = std::move(touch.ranks);
   }

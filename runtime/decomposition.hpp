@@ -3,8 +3,9 @@
 // docs/parallel.md "The decomposed time loop").
 //
 // A rank holds either its part of the model (owned elements and ghost
-// layer, Model::Part: scenes without fracture) or the whole
-// model; either way the work is divided as follows, on the part's local
+// layer, Model::Part; two ghost layers with fracture) or the whole model
+// (scenes with both fracture and contact); either way the work is divided
+// as follows, on the part's local
 // ids, the granules and blocks being those of the whole model. The elements are cut into granules of ElementForces::kGranule
 // consecutive elements (consecutive in the locality order, so a granule is a
 // compact piece of a body) and METIS k-way partitions the granule graph (two

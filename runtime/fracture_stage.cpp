@@ -1,19 +1,30 @@
 #include "runtime/fracture_stage.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 
 #include "fracture/facet_criterion.hpp"
 #include "fracture/strength_scatter.hpp"
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
+#include "runtime/timed.hpp"
 
 namespace shatter {
 
+namespace {
+
+/// The largest node global id of the whole model (the split copies' names start past it).
+GlobalId largest_node_gid(const Mesh& mesh, const Decomposition& dec) {
+  const long mine = mesh.node_gid.empty() ? 0 : *std::max_element(mesh.node_gid.begin(), mesh.node_gid.end());
+  return dec.max(mine);
+}
+
+}  // namespace
+
 FractureStage::FractureStage(Model& model, const Decomposition& dec)
-    : model_(model), dec_(dec), topology_(build_topology(model.mesh)) {
+    : model_(model), dec_(dec), topology_(build_topology(model.mesh, largest_node_gid(model.mesh, dec))) {
   const Mesh& mesh = model.mesh;
   const size_t nm = model.scene.materials.size();
   // The whole model's smallest altitude per material, from the owned elements.
@@ -122,15 +133,25 @@ CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3
 
 std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const double> stress6,
                                         std::span<const Index> local, std::span<const Index> owned) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Index> critical = critical_facets(model_.mesh, topology_, x, stress6, 6, laws(), local, owned);
-  check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return critical;
+  return timed(check_seconds_, check_cpu_seconds_,
+               [&] { return critical_facets(model_.mesh, topology_, x, stress6, 6, laws(), local, owned); });
 }
 
-Insertion FractureStage::insert(std::span<const Index> facets) {
-  if (facets.empty()) return {};
-  return insert_cohesive_elements(model_.mesh, topology_, cohesive_, facets);
+Insertion FractureStage::insert(std::span<const GlobalId> gids) {
+  std::vector<GlobalId> sorted(gids.begin(), gids.end());
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  const std::vector<Index> held = facets(sorted);
+  Insertion ins;
+  ins.first_cohesive = cohesive_.size();
+  if (!held.empty()) ins = insert_cohesive_elements(model_.mesh, topology_, cohesive_, held);
+  // The whole model inserts the list in the order of the facet ids.
+  for (Index c = ins.first_cohesive; c < cohesive_.size(); ++c)
+    cohesive_whole_.push_back(whole_cohesive_ + static_cast<Index>(std::lower_bound(sorted.begin(), sorted.end(),
+                                                                                    topology_.facet_gid[cohesive_.facet[c]]) -
+                                                                   sorted.begin()));
+  whole_cohesive_ += static_cast<Index>(sorted.size());
+  return ins;
 }
 
 double FractureStage::eigenvalue_bound(std::span<const double> mass) {
@@ -170,29 +191,22 @@ std::vector<std::array<Index, 2>> FractureStage::bonded_twins() const {
   return twins;
 }
 
-Index FractureStage::release(std::span<const Index> facets) {
-  for (Index f : facets) topology_.facet_state[f] = FacetState::free;
-  const Index freed = static_cast<Index>(facets.size());
-  released_ += freed;  // freed facets exert no force: the eigenvalue bound's key changes
-  if (freed > 0) ++facet_revision_;
-  return freed;
+Index FractureStage::release(std::span<const GlobalId> gids) {
+  const std::vector<Index> held = facets(gids);
+  for (Index f : held) topology_.facet_state[f] = FacetState::free;
+  released_ += static_cast<Index>(held.size());  // freed facets exert no force: the eigenvalue bound's key changes
+  // (The fragments change on every rank, whichever facets it holds.)
+  if (!gids.empty()) ++facet_revision_;
+  return static_cast<Index>(gids.size());
 }
 
-std::vector<double> FractureStage::owned_delta_max(const FractureState& from, std::vector<Index>& rows) const {
-  rows.clear();
-  const bool all = !dec_.distributed();
-  const auto saved = static_cast<Index>(from.cohesive_facet_gid.size());
-  const Index n = all ? saved : static_cast<Index>(computed_.size());
-  std::vector<double> values;
-  // (Elements are appended: those of an earlier state keep their index and owner.)
-  for (Index i = 0; i < n; ++i) {
-    const Index c = all ? i : computed_[i];
-    if (c >= saved || (!all && !owned_[i])) continue;
-    rows.push_back(c);
-    const double* d = from.cohesive.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
-    values.insert(values.end(), d, d + kCohesivePoints);
+long FractureStage::across_ranks() const {
+  long mine = 0;
+  for (Index f : cohesive_.facet) {
+    const auto [e0, e1] = topology_.facet_elem[f];
+    mine += dec_.owns_element(e0) && dec_.element_rank(e1) != dec_.rank();
   }
-  return values;
+  return dec_.sum(std::vector<long>{mine})[0];
 }
 
 const Fragments& FractureStage::fragment_labels() const {
@@ -205,7 +219,8 @@ const Fragments& FractureStage::fragment_labels() const {
 
 void FractureStage::save(FractureState& s) const {
   const Mesh& mesh = model_.mesh;
-  if (s.mesh_revision != mesh.revision) {
+  // (On a part the outer ghost layer may split without a new revision: the sizes tell.)
+  if (s.mesh_revision != mesh.revision || s.reference.size() != static_cast<size_t>(mesh.num_nodes())) {
     s.mesh_revision = mesh.revision;
     s.reference = mesh.reference;
     s.node_gid = mesh.node_gid;
@@ -227,9 +242,14 @@ void FractureStage::save(FractureState& s) const {
   s.cohesive = cohesive_;
   s.cohesive.facet.clear();
   s.cohesive_facet_gid = gids(cohesive_.facet);
+  s.whole_nodes = model_.whole_nodes();
+  s.whole_cohesive = whole_cohesive_;
+  s.cohesive_whole = cohesive_whole_;
 }
 
-void FractureStage::restore(const FractureState& s) {
+void FractureStage::restore(const FractureState& whole) {
+  const FractureState local = model_.holds_two_layers() ? part_of(whole) : FractureState{};
+  const FractureState& s = model_.holds_two_layers() ? local : whole;
   Mesh& mesh = model_.mesh;
   const size_t n = s.reference.size(), ne = mesh.num_elements(), k = mesh.nodes_per_element();
   SHATTER_REQUIRE(n >= static_cast<size_t>(mesh.num_nodes()) && s.node_gid.size() == n && s.node_body.size() == n &&
@@ -283,6 +303,12 @@ void FractureStage::restore(const FractureState& s) {
   ++facet_revision_;
   cohesive_ = s.cohesive;
   cohesive_.facet = cohesive_facets;
+  whole_cohesive_ = model_.holds_two_layers() ? s.whole_cohesive : cohesive_.size();
+  cohesive_whole_ = s.cohesive_whole;
+  if (!model_.holds_two_layers()) {
+    cohesive_whole_.resize(cohesive_.size());
+    std::iota(cohesive_whole_.begin(), cohesive_whole_.end(), 0);
+  }
   bound_key_ = {-1, -1, -1};  // the cohesive elements changed: compute the bound afresh
 }
 

@@ -37,6 +37,10 @@ inline constexpr int kCohesiveSlots = 2 * 6;
 ///   cohesive       every cohesive element with its delta_max; its facet ids
 ///                  are not kept (local to a topology): cohesive_facet_gid[c]
 ///                  names each one's facet
+/// On parts (Model::holds_two_layers) a rank saves its part's state, node ids
+/// local, with whole_nodes, whole_cohesive and cohesive_whole to place it in
+/// the whole model's (FractureStage::gather); a checkpoint holds the whole
+/// model's state.
 struct FractureState {
   std::uint64_t mesh_revision = ~std::uint64_t{0};  ///< none copied yet
   std::vector<Vec3> reference;
@@ -51,6 +55,8 @@ struct FractureState {
   std::vector<FacetState> facet_state;
   CohesiveElements cohesive;
   std::vector<GlobalId> cohesive_facet_gid;
+  Index whole_nodes = 0, whole_cohesive = 0;  ///< the whole model's counts
+  std::vector<Index> cohesive_whole;           ///< [c]: index among the whole model's cohesive elements
 };
 
 class FractureStage {
@@ -102,10 +108,11 @@ class FractureStage {
   /// and `owned` elements, empty on one rank).
   std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6,
                            std::span<const Index> local = {}, std::span<const Index> owned = {});
-  /// The facets become cohesive elements (in canonical order, whatever the
-  /// order given); nodes split. Returns what changed (new nodes to fill in by
-  /// the caller).
-  Insertion insert(std::span<const Index> facets);
+  /// The facets of `gids` (every rank's critical facets, by global id, the
+  /// same list on every rank) that are held here become cohesive elements
+  /// (in canonical order, whatever the order given); nodes split. Returns
+  /// what changed here (new nodes to fill in by the caller).
+  Insertion insert(std::span<const GlobalId> gids);
   const Topology& topology() const { return topology_; }
   /// Both faces (element, local face) of every cohesive facet not yet freed, ascending.
   std::vector<std::pair<Index, int>> bonded_faces() const;
@@ -125,12 +132,15 @@ class FractureStage {
   /// The facets among those owned here that are fully debonded and not in
   /// compression at positions x (debonded_facets), to free on every rank.
   std::vector<Index> debonded(std::span<const Vec3> x) const;
-  /// Frees `facets` (every rank's debonded(), the same list everywhere); returns how many.
-  Index release(std::span<const Index> facets);
-  /// The delta_max in `from` (a saved state) of the cohesive elements owned
-  /// here (rows: their indices, ascending; kCohesivePoints values per row),
-  /// for a checkpoint's gather.
-  std::vector<double> owned_delta_max(const FractureState& from, std::vector<Index>& rows) const;
+  /// Frees the facets of `gids` held here (every rank's debonded(), by global
+  /// id, the same list everywhere); returns how many the whole model freed.
+  Index release(std::span<const GlobalId> gids);
+  /// The whole model's state on rank 0 (empty elsewhere) from `mine`, a state
+  /// saved here (save()) since the last insertion or earlier: each node from
+  /// its owner, each element's connectivity and each cohesive element (with
+  /// its facet's state) from its owner, which computes it. For checkpoints
+  /// on several ranks (runtime/fracture_parts.cpp). Collective.
+  FractureState gather(const FractureState& mine) const;
 
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);
@@ -140,7 +150,8 @@ class FractureStage {
   /// needed; FragmentLabels, collective). Recomputed only after facets were
   /// freed or the state restored: nothing else changes them.
   const Fragments& fragment_labels() const;
-  Index cohesive_count() const { return cohesive_.size(); }
+  /// The whole model's cohesive elements (a part computes some of them).
+  Index cohesive_count() const { return whole_cohesive_; }
   /// The crack surface (crack_area) of the cohesive elements owned here, with
   /// the fragments `frags` of the current state (to sum over the ranks).
   CrackArea crack_area(const Fragments& frags) const {
@@ -155,10 +166,17 @@ class FractureStage {
   void save(FractureState& state) const;
   /// Puts `state` (saved from a run of the same model) back into the model's
   /// mesh and per-node arrays, the facet states and the cohesive elements.
-  /// The caller resizes its own nodal arrays to the mesh. Throws Error when
-  /// the arrays do not fit the model (sizes, node or facet ids out of range).
+  /// On parts `state` is the whole model's (a checkpoint's): the part takes
+  /// its elements' nodes, renumbered, and the cohesive elements of its facets
+  /// (Model::Part's node indices follow). The caller resizes its own nodal
+  /// arrays to the mesh. Throws Error when the arrays do not fit the model
+  /// (sizes, node or facet ids out of range).
   void restore(const FractureState& state);
   double check_seconds() const { return check_seconds_; }
+  double check_cpu_seconds() const { return check_cpu_seconds_; }  ///< this rank's thread CPU time
+  /// The whole model's cohesive elements whose two elements two ranks own
+  /// (cracks across subdomains; collective).
+  long across_ranks() const;
 
  private:
   Model& model_;
@@ -166,6 +184,10 @@ class FractureStage {
   Topology topology_;
   std::vector<Index> by_gid_;  ///< interior facets, ascending by facet_gid
   CohesiveElements cohesive_;
+  std::vector<Index> cohesive_whole_;  ///< [c]: index among the whole model's cohesive elements
+  Index whole_cohesive_ = 0;           ///< the whole model's cohesive elements
+  /// The part's share of the whole model's state `whole` (restore on parts).
+  FractureState part_of(const FractureState& whole);
   std::vector<std::optional<CohesiveLaw>> laws_;
   std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
   double weakest_facet_ = 0;            ///< min of facet_strength_, Pa
@@ -174,7 +196,7 @@ class FractureStage {
   std::vector<Index> computed_;
   std::vector<std::uint8_t> owned_;
   CohesiveShare mine() const { return {computed_, owned_, !dec_.distributed()}; }
-  double check_seconds_ = 0;
+  double check_seconds_ = 0, check_cpu_seconds_ = 0;
   long facet_revision_ = 0;  ///< bumped when facets are freed or the state is restored
   std::unique_ptr<FragmentLabels> labeler_;  ///< from the first share_with
   mutable Fragments labels_;

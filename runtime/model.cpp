@@ -142,8 +142,8 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
     m.mesh = mesh_bodies(scene, max_elements, groups);
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
-  } else if (scene.fracture_enabled()) {
-    // Fracture still needs the whole model on every rank (docs/parallel.md "Limits").
+  } else if (scene.fracture_enabled() && scene.contact) {
+    // Cracks in contact still need the whole model on every rank (docs/parallel.md "Limits").
     on_root(comm, [&] {
       m.mesh = mesh_bodies(scene, max_elements, groups);
       selection = select_regions(scene, m.mesh, groups);

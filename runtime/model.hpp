@@ -52,15 +52,18 @@ struct Model {
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
   /// its owned elements and their ghost layer, ascending in the whole
   /// model's order, and the nodes they use (with contact, and the contact
-  /// surface's nodes). Empty `element_index`: this
-  /// model is the whole one (one rank, or a scene every rank holds whole).
+  /// surface's nodes). With fracture, two ghost layers (holds_two_layers()).
+  /// Empty `element_index`: this model is the whole one (one rank, or a
+  /// scene every rank holds whole).
   struct Part {
     std::vector<Index> element_index;  ///< per element: its index in the whole model
     std::vector<Index> node_index;     ///< per node: its index in the whole model
     std::vector<int> block_color;      ///< per element block held here (ascending): the whole model's block color
     std::vector<int> granule_rank;     ///< per granule of the whole model: its owner (METIS)
+    /// CSR per node: the ranks whose owned elements use it, ascending (empty
+    /// with two layers, where every node a rank reads has its whole star held)
     std::vector<Index> node_rank_offsets;
-    std::vector<int> node_ranks;       ///< CSR per node: the ranks whose owned elements use it, ascending
+    std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
     /// Contact scenes: the whole model's contact surface (build_contact_surface),
     /// in local node ids; its nodes are held here, in elements or not.
@@ -69,6 +72,11 @@ struct Model {
     std::uint64_t fingerprint = 0;     ///< model_fingerprint() of the whole model
   } part;
   bool is_part() const { return !part.element_index.empty(); }
+  /// A part of a fracture scene (docs/parallel.md "Fracture on parts"): it
+  /// holds a second ghost layer (every element sharing a node with the
+  /// first), so every node of an owned or first-layer element has its whole
+  /// star here and splits as on one rank.
+  bool holds_two_layers() const { return is_part() && scene.fracture_enabled(); }
   Index whole_element(Index e) const { return is_part() ? part.element_index[e] : e; }
   Index whole_node(Index n) const { return is_part() ? part.node_index[n] : n; }
   /// The local index of the whole model's element `whole`, -1 when not held here.
@@ -90,9 +98,9 @@ void for_each_array(M& m, F f) {
 
 /// Mesh every body, check the meshes, and compute every constant of the model.
 /// On several ranks of `comm` (collective) rank 0 meshes and computes the
-/// whole model. A scene without fracture is then cut: rank 0
+/// whole model. A scene without both fracture and contact is then cut: rank 0
 /// partitions it (METIS granules) and sends every rank its part (owned
-/// elements and ghost layer, Model::Part), keeping its own; otherwise every
+/// elements and ghost layers, Model::Part), keeping its own; otherwise every
 /// rank receives the mesh and computes the whole model. Throws InputError
 /// (bad scene or mesh) on every rank.
 /// Before meshing, a primitive beyond kMaxCoordinate, or primitives whose

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "kernels/error.hpp"
+#include "mesh/topology.hpp"
 #include "contact/surface.hpp"
 #include "mesh/partition.hpp"
 #include "runtime/checkpoint.hpp"
@@ -40,19 +41,47 @@ Partition partition(const Model& whole, int ranks) {
   return p;
 }
 
-/// The elements each rank holds (its owned ones and their ghost layer:
-/// every element with a node it touches), ascending; one pass over the mesh.
-std::vector<std::vector<Index>> held_elements(const Mesh& wm, const NodeRanks& touch, int ranks) {
-  std::vector<std::vector<Index>> held(ranks);
-  std::vector<int> rs;
-  for (Index e = 0; e < wm.num_elements(); ++e) {
-    rs.clear();
-    for (int a = 0; a < wm.nodes_per_element(); ++a)
+/// The elements each rank holds, ascending: its owned ones and their ghost
+/// layer (every element with a node it touches), and with `two_layers` the
+/// elements sharing a node with those. A few passes over the mesh.
+std::vector<std::vector<Index>> held_elements(const Mesh& wm, const NodeRanks& touch, int ranks, bool two_layers) {
+  const Index ne = wm.num_elements(), nn = wm.num_nodes();
+  const int k = wm.nodes_per_element();
+  // (CSR of ranks per element or node, each list ascending.)
+  auto gather = [&](Index count, auto lists_of) {
+    NodeRanks out;
+    out.offsets.assign(1, 0);
+    std::vector<int> rs;
+    for (Index i = 0; i < count; ++i) {
+      rs.clear();
+      lists_of(i, rs);
+      std::sort(rs.begin(), rs.end());
+      rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+      out.ranks.insert(out.ranks.end(), rs.begin(), rs.end());
+      out.offsets.push_back(static_cast<Index>(out.ranks.size()));
+    }
+    return out;
+  };
+  // The ranks whose first layer holds each element.
+  NodeRanks layer = gather(ne, [&](Index e, std::vector<int>& rs) {
+    for (int a = 0; a < k; ++a)
       for (int q : touch.of(wm.element(e)[a])) rs.push_back(q);
-    std::sort(rs.begin(), rs.end());
-    rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
-    for (int q : rs) held[q].push_back(e);
+  });
+  if (two_layers) {
+    // Those holding an element of each node's star, then each element's.
+    std::vector<std::vector<int>> at(nn);
+    for (Index e = 0; e < ne; ++e)
+      for (int a = 0; a < k; ++a)
+        for (int q : layer.of(e)) at[wm.element(e)[a]].push_back(q);
+    const NodeRanks star = gather(nn, [&](Index n, std::vector<int>& rs) { rs.swap(at[n]); });
+    layer = gather(ne, [&](Index e, std::vector<int>& rs) {
+      for (int a = 0; a < k; ++a)
+        for (int q : star.of(wm.element(e)[a])) rs.push_back(q);
+    });
   }
+  std::vector<std::vector<Index>> held(ranks);
+  for (Index e = 0; e < ne; ++e)
+    for (int q : layer.of(e)) held[q].push_back(e);
   return held;
 }
 
@@ -61,6 +90,7 @@ std::vector<std::vector<Index>> held_elements(const Mesh& wm, const NodeRanks& t
 /// entry and on return.
 Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, std::vector<Index>& local) {
   const Mesh& wm = whole.mesh;
+  const bool two_layers = whole.scene.fracture_enabled();
   const int k = wm.nodes_per_element();
   Model m;
   Model::Part& part = m.part;
@@ -85,10 +115,11 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
     m.bc_condition.push_back(whole.bc_condition[n]);
     m.initial_velocity.push_back(whole.initial_velocity[n]);
     if (whole.bc_mask[n]) part.bc_index.push_back(p.bc_index[n]);
+    if (two_layers) continue;
     part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
     for (int q : p.touch.of(n)) part.node_ranks.push_back(q);
   }
-  part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
+  if (!two_layers) part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
   Index last_block = -1;
   for (Index e : part.element_index) {
     for (int a = 0; a < k; ++a) {
@@ -167,13 +198,48 @@ void receive_part(Model& m, MPI_Comm comm) {
 
 }  // namespace
 
+Index number_split_nodes(Model& m, Index first, std::uint64_t revision, const Decomposition& dec) {
+  Mesh& mesh = m.mesh;
+  Model::Part& part = m.part;
+  const Index nn = mesh.num_nodes();
+  SHATTER_REQUIRE(m.bc_mask.size() == static_cast<size_t>(nn), "number_split_nodes: the model's node arrays are not grown");
+  auto owner = [&](Index n) {
+    int r = dec.size();
+    for (Index e : node_star(mesh, n)) r = std::min(r, part.granule_rank[part.element_index[e] / ElementForces::kGranule]);
+    return r;
+  };
+  // Names, doubled, plus one for a copy with a prescribed component.
+  auto key = [&](Index n) { return 2 * mesh.node_gid[n] + (m.bc_mask[n] ? 1 : 0); };
+  std::vector<GlobalId> mine;
+  for (Index n = first; n < nn; ++n)
+    if (owner(n) == dec.rank()) mine.push_back(key(n));
+  std::vector<GlobalId> all = dec.allgather(std::span<const GlobalId>(mine));
+  std::sort(all.begin(), all.end());
+  std::vector<GlobalId> held;  // the prescribed ones
+  for (GlobalId g : all)
+    if (g & 1) held.push_back(g);
+  for (Index n = first; n < nn; ++n) {
+    const auto it = std::lower_bound(all.begin(), all.end(), key(n));
+    const bool named = it != all.end() && *it == key(n);
+    part.node_index.push_back(named ? part.whole_nodes + static_cast<Index>(it - all.begin()) : -1);
+    if (!m.bc_mask[n]) continue;
+    part.bc_index.push_back(named ? part.whole_bc_nodes + static_cast<Index>(std::lower_bound(held.begin(), held.end(), key(n)) - held.begin())
+                                  : -1);
+  }
+  part.whole_nodes += static_cast<Index>(all.size());
+  part.whole_bc_nodes += static_cast<Index>(held.size());
+  // (The outer layer may have split alone: the whole model's revision, as fields.h5 writes it.)
+  mesh.revision = revision + (all.empty() ? 0 : 1);
+  return static_cast<Index>(all.size());
+}
+
 void distribute_parts(Model& model, MPI_Comm comm) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
   if (rank != 0) return receive_part(model, comm);
   const Partition p = partition(model, ranks);
-  std::vector<std::vector<Index>> held = held_elements(model.mesh, p.touch, ranks);
+  std::vector<std::vector<Index>> held = held_elements(model.mesh, p.touch, ranks, model.scene.fracture_enabled());
   std::vector<Index> local(model.mesh.num_nodes(), -1);
   for (int r = 1; r < ranks; ++r) send_part(cut(model, p, std::move(held[r]), local), r, comm);
   Model mine = cut(model, p, std::move(held[0]), local);

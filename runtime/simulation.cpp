@@ -13,6 +13,7 @@
 #include "runtime/diagnosis.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/model_part.hpp"
 #include "runtime/loads.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
@@ -290,30 +291,38 @@ void Simulation::apply_fracture() {
   // checked by the owner of its smaller element, which holds both elements'
   // stresses. Every rank frees and inserts the gathered lists (by facet
   // global id) where it holds the facets.
-  const Index freed =
-      fracture_->release(fracture_->facets(dec_->allgather(fracture_->gids(fracture_->debonded(x_)))));
-  const std::vector<Index> critical =
+  const Index freed = fracture_->release(dec_->allgather(fracture_->gids(fracture_->debonded(x_))));
+  const std::vector<GlobalId> critical =
       dec_->distributed()
-          ? fracture_->facets(dec_->allgather(fracture_->gids(
-                fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids()))))
-          : fracture_->check(x_, stress6_);
+          ? dec_->allgather(fracture_->gids(
+                fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids())))
+          : fracture_->gids(fracture_->check(x_, stress6_));
   const Index before = fracture_->cohesive_count();
-  const Insertion ins = fracture_->insert(critical);
-  ledger_.cohesive_elements = fracture_->cohesive_count();
-  if (ledger_.cohesive_elements == before) {
-    // Freed facets' faces join the contact surface.
-    if (contact_ && freed > 0) rebuild_contact_surface();
-    return;
-  }
-  if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
-  dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
-  // After the node lists: the contact patch asks who owns the new nodes.
-  if (contact_ && (freed > 0 || !ins.new_nodes.empty())) rebuild_contact_surface();
-  share_plans();
+  bool inserted = false;
+  Index created = 0;
+  timed(insert_seconds_, insert_cpu_seconds_, [&] {
+    const std::uint64_t revision = model_.mesh.revision;
+    const Insertion ins = fracture_->insert(critical);
+    ledger_.cohesive_elements = fracture_->cohesive_count();
+    if (ledger_.cohesive_elements == before) return;
+    inserted = true;
+    if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
+    // On parts a rank may split nodes that others do not hold (every rank holding
+    // one splits it alike): the whole model's count decides the forces' update.
+    const auto here = static_cast<Index>(ins.new_nodes.size());
+    created = model_.holds_two_layers() ? number_split_nodes(model_, model_.mesh.num_nodes() - here, revision, *dec_)
+                                        : here;
+    dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
+    // After the node lists: the contact patch asks who owns the new nodes.
+    if (contact_ && (freed > 0 || here > 0)) rebuild_contact_surface();
+    share_plans();
+  });
+  // Freed facets' faces join the contact surface.
+  if (!inserted && contact_ && freed > 0) rebuild_contact_surface();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
   // unchanged).
-  if (!ins.new_nodes.empty()) compute_forces(step_, time_);
+  if (created > 0) compute_forces(step_, time_);
 }
 
 void Simulation::rebuild_contact_surface() {

@@ -165,10 +165,15 @@ class Simulation {
   template <int K, class Term>
   std::array<ExactSum, K> granule_sums(Term term) const;
   void write_outputs(bool fields);
-  /// `crack`: the crack surface at the end (fracture only; write_fragments).
+  /// What the summary says of fracture, over the ranks.
+  struct FractureSummary {
+    CrackArea crack;              ///< the crack surface at the end (write_fragments)
+    long across_ranks = 0;        ///< FractureStage::across_ranks
+    double check_cpu_max = 0, insert_cpu_max = 0;  ///< the largest rank's thread CPU time, s
+  };
   /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
   void write_summary(double wall_seconds, const DecompositionStats& stats, const ContactBalance& contact_balance,
-                     const CrackArea& crack, const std::pair<std::vector<long>, long>& memory);
+                     const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory);
   /// Bytes of the arrays this rank holds in the loop: the model's and the
   /// time loop's own (nodal state, stresses); the contact and fracture
   /// stages' are not counted.
@@ -228,6 +233,8 @@ class Simulation {
   ElementLoopResult last_elements_;
   double element_seconds_ = 0;
   double comm_seconds_ = 0;  ///< in MPI exchanges of the step (ghosts, shared nodes, granule sums)
+  /// inserting cohesive elements (splits, numbering, node lists): wall and thread CPU time
+  double insert_seconds_ = 0, insert_cpu_seconds_ = 0;
   double total0_ = 0, energy_scale_ = 0;
   std::unique_ptr<ContactStage> contact_;   ///< null without a contact block
   std::vector<Vec3> x_prev_;                ///< x(n) during a step (contact only)

@@ -163,7 +163,7 @@ long Simulation::loop_bytes() const {
 }
 
 void Simulation::write_summary(double wall, const DecompositionStats& stats, const ContactBalance& contact_balance,
-                               const CrackArea& crack, const std::pair<std::vector<long>, long>& memory) {
+                               const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -214,16 +214,14 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("contact_capped_steps", l.contact_capped_steps);
   if (fracture_) {
     j.add("fracture_check_time", fracture_->check_seconds());
+    j.add("fracture_insert_time", insert_seconds_);
+    j.add("fracture_check_cpu_time_max", fracture.check_cpu_max);
+    j.add("fracture_insert_cpu_time_max", fracture.insert_cpu_max);
     // Cohesive elements between elements of different ranks: cracks across subdomains.
-    long across = 0;
-    for (Index f : fracture_->cohesive_facets()) {
-      const auto& fe = fracture_->topology().facet_elem[f];
-      across += dec_->granule_rank(fe[0] / ElementForces::kGranule) != dec_->granule_rank(fe[1] / ElementForces::kGranule);
-    }
-    j.add("cohesive_elements_across_ranks", across);
-    j.add("crack_area_debonded", crack.debonded.value());
-    j.add("crack_area_between_fragments", crack.between_fragments.value());
-    j.add("cohesive_dissipated_debonded", crack.debonded_dissipated.value());
+    j.add("cohesive_elements_across_ranks", fracture.across_ranks);
+    j.add("crack_area_debonded", fracture.crack.debonded.value());
+    j.add("crack_area_between_fragments", fracture.crack.between_fragments.value());
+    j.add("cohesive_dissipated_debonded", fracture.crack.debonded_dissipated.value());
   }
   if (contact_) {
     j.add("contact_search_time", contact_->search_seconds());

@@ -107,11 +107,14 @@ long Simulation::run() {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   fields_.reset();
   if (!opt_.out_dir.empty()) {
-    const CrackArea crack = fracture_ ? write_fragments() : CrackArea{};
+    FractureSummary fracture;
+    if (fracture_)
+      fracture = {write_fragments(), fracture_->across_ranks(), -dec_->min(-fracture_->check_cpu_seconds()),
+                  -dec_->min(-insert_cpu_seconds_)};
     const DecompositionStats stats = dec_->stats();
     const ContactBalance pairs = contact_ ? contact_->balance() : ContactBalance{};
     const std::pair<std::vector<long>, long> memory{dec_->gather(peak_memory_bytes()), dec_->max(loop_bytes())};
-    if (root) write_summary(wall, stats, pairs, crack, memory);
+    if (root) write_summary(wall, stats, pairs, fracture, memory);
   }
   return step_;
 }

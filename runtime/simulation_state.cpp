@@ -2,6 +2,7 @@
 // step as the last good state, restored for --restart, written as a
 // checkpoint (runtime/checkpoint.hpp).
 #include <algorithm>
+#include <optional>
 
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
@@ -33,16 +34,16 @@ void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationSt
       for (size_t i = 0; i < whole[6].size(); ++i)
         if (whole[6][i].x() != 0) s.reaction.push_back(whole[5][i]);
     }
-    if (fracture_) {
-      // Each cohesive element's delta_max from its owner, which computes it.
-      std::vector<Index> rows;
-      const std::vector<double> mine = fracture_->owned_delta_max(*s.fracture, rows);
-      std::vector<double> all;
-      timed(comm_seconds_, [&] {
-        all = to_root(rows, mine, kCohesivePoints, static_cast<Index>(s.fracture->cohesive_facet_gid.size()),
-                      dec_->comm());
-      });
-      if (dec_->rank() == 0) s.fracture->cohesive.delta_max = std::move(all);
+  }
+  // The whole model's fracture state, from the owners, in place of rank 0's own
+  // until the checkpoint is written (the next saves fill in their own).
+  std::optional<FractureState> mine;
+  if (fracture_ && dec_->distributed()) {
+    FractureState whole;
+    timed(comm_seconds_, [&] { whole = fracture_->gather(*s.fracture); });
+    if (dec_->rank() == 0) {
+      mine = std::move(*s.fracture);
+      *s.fracture = std::move(whole);
     }
   }
   std::string failure;
@@ -51,6 +52,7 @@ void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationSt
     } catch (const Error& e) {
       failure = e.what();
     }
+  if (mine) *s.fracture = std::move(*mine);
   if (dec_->max(failure.empty() ? 0 : 1)) throw Error(failure.empty() ? "writing the checkpoint failed on rank 0" : failure);
 }
 
@@ -99,17 +101,26 @@ void Simulation::restore_state(const SimulationState& s) {
     if (contact_ && model_.mesh.revision != built_revision) rebuild_contact_surface();
     share_plans();
   }
-  const size_t n = model_.mesh.num_nodes();
+  // On parts with fracture the state is the whole model's (a checkpoint's): this part's rows.
+  const bool whole = model_.holds_two_layers();
+  const size_t n = whole ? model_.whole_nodes() : model_.mesh.num_nodes();
+  const size_t b = whole ? model_.part.whole_bc_nodes : bc_nodes_.size();
   SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
-                      s.f_ext.size() == n && s.reaction.size() == bc_nodes_.size(),
+                      s.f_ext.size() == n && s.reaction.size() == b,
                   "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
-                                                  << " reactions, the model " << n << " and " << bc_nodes_.size());
-  x_ = s.x;
-  v_ = s.v;
-  a_ = s.a;
-  f_int_ = s.f_int;
-  f_ext_ = s.f_ext;
-  reaction_ = s.reaction;
+                                                  << " reactions, the model " << n << " and " << b);
+  auto rows = [&](const std::vector<Vec3>& from, std::span<const Index> index) {
+    if (!whole) return from;
+    std::vector<Vec3> to;
+    for (Index i : index) to.push_back(from[i]);
+    return to;
+  };
+  x_ = rows(s.x, model_.part.node_index);
+  v_ = rows(s.v, model_.part.node_index);
+  a_ = rows(s.a, model_.part.node_index);
+  f_int_ = rows(s.f_int, model_.part.node_index);
+  f_ext_ = rows(s.f_ext, model_.part.node_index);
+  reaction_ = rows(s.reaction, model_.part.bc_index);
   restore_scalars(s);
   if (loads_) {
     // The loads at x(n), which the next step's work starts from.

@@ -78,7 +78,9 @@ TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
   }
   EXPECT_GT(nonempty, 100);
   EXPECT_LT(stage.searches(), 40) << "the candidates were not reused";
-  if (dec.distributed()) EXPECT_GT(stage.profile().state_bytes, 0) << "no state travelled";
+  if (dec.distributed()) {
+    EXPECT_GT(stage.profile().state_bytes, 0) << "no state travelled";
+  }
 }
 
 }  // namespace

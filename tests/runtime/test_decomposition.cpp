@@ -14,7 +14,9 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
+#include "runtime/fracture_stage.hpp"
 #include "runtime/fragment_labels.hpp"
+#include "runtime/model_part.hpp"
 #include "runtime/model.hpp"
 #include "scene_text.hpp"
 
@@ -257,6 +259,69 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   Scene bad = scene;
   bad.bodies[0].mesh_file = "/nonexistent/body.msh";
   EXPECT_THROW(build_model(bad, MPI_COMM_WORLD), InputError);
+}
+
+TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
+  // With fracture a part holds two ghost layers: every node of its owned and
+  // first-layer elements has its whole star, splits as in the whole model,
+  // and takes the whole model's index; the ranks touching it come from the
+  // part's stars. Two rounds of insertion, the second splitting copies.
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const Scene scene = test::scene_from_text(
+      "fracture_parts_rank" + std::to_string(rank),
+      "name: fracture_parts\ntime: {end: 1.0}\nmaterials:\n"
+      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3,\n"
+      "          fracture: {strength: 3.0e8, energy: 100.0, beta: 1.0}}\n"
+      "bodies:\n  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.016, 0.012], element_size: 0.002}}\n");
+  Model part = build_model(scene, MPI_COMM_WORLD);
+  Model whole = build_model(scene);
+  EXPECT_EQ(part.holds_two_layers(), ranks > 1);
+  Decomposition d(part, MPI_COMM_WORLD);
+  const Decomposition one(whole, MPI_COMM_SELF);
+  FractureStage on_part(part, d), on_whole(whole, one);
+  const Topology& wt = on_whole.topology();
+  for (int round : {0, 1}) {
+    std::vector<GlobalId> gids;
+    for (Index f = 0; f < wt.num_facets(); ++f)
+      if (wt.is_interior(f) && wt.facet_state[f] == FacetState::intact &&
+          (static_cast<std::uint64_t>(wt.facet_gid[f]) * 2654435761u + round) % 100 < 12)
+        gids.push_back(wt.facet_gid[f]);
+    on_whole.insert(gids);
+    const std::uint64_t revision = part.mesh.revision;
+    const Index before = part.mesh.num_nodes();
+    on_part.insert(gids);
+    part.bc_mask.resize(part.mesh.num_nodes(), 0);  // (no condition: the copies hold nothing)
+    if (part.holds_two_layers()) {
+      const Index added = number_split_nodes(part, before, revision, d);
+      EXPECT_GT(added, 0) << "round " << round;
+    }
+    EXPECT_EQ(part.whole_nodes(), whole.mesh.num_nodes()) << "round " << round;
+    EXPECT_EQ(part.mesh.revision, whole.mesh.revision) << "round " << round;
+    EXPECT_EQ(on_part.cohesive_count(), on_whole.cohesive_count()) << "round " << round;
+  }
+  d.rebuild_nodes(on_part.side_nodes(), kCohesiveSlots);
+  const Decomposition wd(whole, MPI_COMM_WORLD);
+  const int k = whole.mesh.nodes_per_element();
+  long checked = 0;
+  for (Index e : d.local_elements()) {
+    const Index we = part.whole_element(e);
+    for (int a = 0; a < k; ++a) {
+      const Index n = part.mesh.element(e)[a], w = whole.mesh.element(we)[a];
+      ASSERT_EQ(part.whole_node(n), w) << "element " << we << " node " << a;
+      EXPECT_EQ(part.mesh.node_gid[n], whole.mesh.node_gid[w]);
+      EXPECT_TRUE(same_bits(part.mesh.reference[n], whole.mesh.reference[w]));
+      EXPECT_EQ(node_star(part.mesh, n).size(), node_star(whole.mesh, w).size());
+      const auto mine = d.node_ranks(n), all = wd.node_ranks(w);
+      EXPECT_TRUE(std::equal(mine.begin(), mine.end(), all.begin(), all.end())) << "node " << w;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 0);
+  if (ranks > 1) {
+    EXPECT_LT(d.local_elements().size(), static_cast<size_t>(part.mesh.num_elements()));
+  }
 }
 
 }  // namespace
