@@ -23,11 +23,20 @@
 #       the two boxes with contact, ELEMENTS tets in all (default 4000000) on
 #       RANKS ranks (default 16, oversubscribed), 50 steps of 2e-6 s (they meet
 #       after 5e-5 s): each rank's peak memory, their sum, and the contacts.
+#   [FIRST=R0] bench/mpi_scaling.sh BUILD fracture [PER_RANK] [MAX_RANKS]
+#       weak scaling with fracture (issue 15): an aluminium block (the ring's
+#       material) under a uniform expansion of 2e4 /s cracks everywhere (a hot
+#       field; no contact, so the ranks hold parts with two ghost layers). The
+#       block grows with the ranks at a fixed element size (1e-4 m), about
+#       PER_RANK tets per rank (default 20000), R = R0 (default 1), 2 R0, ...
+#       MAX_RANKS (default 64, oversubscribed), to 1e-7 s: per rank peak memory
+#       and model bytes, ghost bytes and messages per step, and the largest
+#       rank's facet check and insertion thread CPU time per step.
 #
 # Results: bench/results/mpi_scaling_<mode>.csv
 set -euo pipefail
 build=${1:?usage: mpi_scaling.sh BUILD strong|weak|memory ...}
-mode=${2:?strong, weak or memory}
+mode=${2:?strong, weak, memory, capacity or fracture}
 here=$(cd "$(dirname "$0")" && pwd)
 shatter="$build/apps/shatter"
 # Binding (strong runs): a rank of one thread is bound to a core (--bind-to core):
@@ -147,6 +156,44 @@ elif [ "$mode" = memory ]; then
       --set "contact=null" --set "bodies=[{name: box, material: seed, mesh: {shape: box, size: [1.0, 1.0, 1.0], element_size: $h}, initial_velocity: [20.0, 0.0, 0.0]}]" \
       --set time.end=1.0e-9 --set time.dt=5.0e-11
     echo "$r,$(key "$dir" elements),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max)" | tee -a "$out"
+    r=$((r * 2))
+  done
+elif [ "$mode" = fracture ]; then
+  per_rank=${3:-20000}
+  max_ranks=${4:-64}
+  block="$work/block.yaml"
+  cat > "$block" <<'YAML'
+name: fracture_block
+time:
+  end: 1.0e-7
+output:
+  every: 0
+  history_every: 10
+materials:
+  alu:
+    model: neo_hookean
+    density: 2750
+    youngs_modulus: 275.0e9
+    poisson_ratio: 0.3
+    fracture: {strength: 300.0e6, energy: 100.0, beta: 1.0}
+bodies:
+  - name: block
+    material: alu
+    mesh: {shape: box, size: [1.3e-3, 1.3e-3, 1.3e-3], element_size: 1.0e-4}
+    velocity_gradient: [[2.0e4, 0, 0], [0, 2.0e4, 0], [0, 0, 2.0e4]]
+YAML
+  out="$here/results/mpi_scaling_fracture.csv"
+  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,cohesive_elements,check_cpu_ms_per_step_max,insert_cpu_ms_per_step_max" > "$out"
+  r=${FIRST:-1}
+  while [ "$r" -le "$max_ranks" ]; do
+    # 10 561 tets for a side of 1.3e-3 m at this element size.
+    side=$(python3 -c "print(f'{1.3e-3 * ($per_rank * $r / 10561) ** (1 / 3):.6e}')")
+    dir="$work/fracture$r"
+    "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$block" --out "$dir" --threads 1 --quiet \
+      --set "bodies[0].mesh.size=[$side, $side, $side]" 2> /dev/null
+    steps=$(key "$dir" steps)
+    per_step() { key "$dir" "$1" | awk -v n="$steps" '{printf "%.3f", 1e3 * $1 / n}'; }
+    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max),$steps,$(key "$dir" cohesive_elements),$(per_step fracture_check_cpu_time_max),$(per_step fracture_insert_cpu_time_max)" | tee -a "$out"
     r=$((r * 2))
   done
 else
