@@ -173,7 +173,7 @@ std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes, bool r
   for (int r = 0; r < ranks; ++r)
     for (const Index k : asked[r]) send[r].push_back(surface_.vertices[k]);
   if (readers) find_readers(send, receive);
-  return std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm());
+  return std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm(), kPatchTag);
 }
 
 void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,

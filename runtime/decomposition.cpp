@@ -184,7 +184,7 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     for (int q : holders)
       if (!touches(n, q)) send[q].push_back(n);
   }
-  halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_);
+  halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_, kGhostTag);
 }
 
 void Decomposition::begin_ghost_update(std::span<const Vec3> x) const {

@@ -39,7 +39,7 @@ FragmentLabels::FragmentLabels(const Model& model, const Topology& topo, const D
       std::sort(list.begin(), list.end());
       list.erase(std::unique(list.begin(), list.end()), list.end());
     }
-  halo_ = std::make_unique<Halo>(ne, exchange_from(send), exchange_from(recv), dec.comm());
+  halo_ = std::make_unique<Halo>(ne, exchange_from(send), exchange_from(recv), dec.comm(), kFragmentTag);
 }
 
 FragmentLabels::~FragmentLabels() = default;

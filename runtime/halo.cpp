@@ -6,7 +6,6 @@
 
 namespace shatter {
 namespace {
-constexpr int kUpdateTag = 602;
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays are read as node-major doubles");
 
 std::span<double> as_doubles(std::span<Vec3> v) {
@@ -17,14 +16,11 @@ std::span<const double> as_doubles(std::span<const Vec3> v) {
 }
 }  // namespace
 
-Halo::Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm)
-    : num_nodes_(num_nodes), send_(send), recv_(receive) {
-  MPI_Comm_dup(comm, &comm_);
-}
+Halo::Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm, int tag)
+    : comm_(comm), tag_(tag), num_nodes_(num_nodes), send_(send), recv_(receive) {}
 
 Halo::~Halo() {
   if (pending_) wait();
-  MPI_Comm_free(&comm_);
 }
 
 void Halo::check(std::span<const double> values, int components, bool expect_pending) const {
@@ -55,11 +51,11 @@ void Halo::post(int components) {
   requests_.resize(send_.ranks.size() + recv_.ranks.size());
   for (int i = 0; i < recv_.num_ranks(); ++i)
     MPI_Irecv(recv_buffer_.data() + recv_.offsets[i] * c,
-              static_cast<int>((recv_.offsets[i + 1] - recv_.offsets[i]) * c), MPI_DOUBLE, recv_.ranks[i], kUpdateTag,
+              static_cast<int>((recv_.offsets[i + 1] - recv_.offsets[i]) * c), MPI_DOUBLE, recv_.ranks[i], tag_,
               comm_, &requests_[i]);
   for (int i = 0; i < send_.num_ranks(); ++i)
     MPI_Isend(send_buffer_.data() + send_.offsets[i] * c,
-              static_cast<int>((send_.offsets[i + 1] - send_.offsets[i]) * c), MPI_DOUBLE, send_.ranks[i], kUpdateTag,
+              static_cast<int>((send_.offsets[i + 1] - send_.offsets[i]) * c), MPI_DOUBLE, send_.ranks[i], tag_,
               comm_, &requests_[recv_.ranks.size() + i]);
   pending_ = true;
 }

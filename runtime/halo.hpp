@@ -29,14 +29,20 @@ namespace shatter {
 /// end the caller may not change the entries that are sent nor read the
 /// entries that will be written. MPI is called only from the calling thread
 /// (MPI_THREAD_FUNNELED suffices).
+/// The tags of the Halos that share a decomposition's communicator.
+enum HaloTag : int { kGhostTag = 7401, kFragmentTag = 7402, kPatchTag = 7403 };
+
 class Halo {
  public:
   /// `send` lists, per other rank, the nodes of the `num_nodes` whose values
   /// go there, `receive` the nodes filled from each rank; the list rank r
   /// sends to q must name the same nodes, in the same order, as the list q
-  /// receives from r. The lists are copied. Collective over `comm`
-  /// (duplicated, so messages never mix with the caller's).
-  Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm);
+  /// receives from r. The lists are copied. Not collective: `comm` is used
+  /// as it is (a duplicate per Halo cost an MPI_Comm_dup, a collective, at
+  /// every new plan), and `tag` (HaloTag) keeps the messages of one kind of
+  /// exchange apart from the others' on it; the ranks run the updates of one
+  /// tag in the same order.
+  Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm, int tag);
   ~Halo();
   Halo(const Halo&) = delete;
   Halo& operator=(const Halo&) = delete;
@@ -65,6 +71,7 @@ class Halo {
   void post(int components);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
+  int tag_ = 0;
   Index num_nodes_ = 0;
   NodeExchange send_, recv_;
   std::vector<double> send_buffer_, recv_buffer_;

@@ -118,7 +118,7 @@ long received_over_ranks(const Exchange& x) {
 
 TEST(Halo, UpdateDeliversTheOwnersValuesBitForBit) {
   const Exchange x(holds_quarter);
-  Halo halo(kNodes, x.send, x.receive, MPI_COMM_WORLD);
+  Halo halo(kNodes, x.send, x.receive, MPI_COMM_WORLD, kGhostTag);
   if (x.size > 1) {
     EXPECT_GT(received_over_ranks(x), 0) << "the lists exchange something";
   }
@@ -159,10 +159,10 @@ TEST(Halo, UpdateDeliversTheOwnersValuesBitForBit) {
 }
 
 TEST(Halo, TwoHalosOnOneCommunicatorDoNotMixMessages) {
-  // Odd ranks post the second Halo's messages first; on a shared
-  // communicator and tag they would be matched to the first's receives.
+  // Odd ranks post the second Halo's messages first; with one tag they
+  // would be matched to the first's receives (HaloTag keeps them apart).
   const Exchange xa(holds_quarter), xb(holds_third);
-  Halo a(kNodes, xa.send, xa.receive, MPI_COMM_WORLD), b(kNodes, xb.send, xb.receive, MPI_COMM_WORLD);
+  Halo a(kNodes, xa.send, xa.receive, MPI_COMM_WORLD, kGhostTag), b(kNodes, xb.send, xb.receive, MPI_COMM_WORLD, kPatchTag);
   std::vector<double> va = before_update(xa, 2), vb = before_update(xb, 2, -3.0);
   if (xa.rank % 2 == 0) {
     a.begin_update(va, 2);
@@ -179,7 +179,7 @@ TEST(Halo, TwoHalosOnOneCommunicatorDoNotMixMessages) {
 
 TEST(Halo, CallsOutOfOrderOrOfTheWrongSizeThrow) {
   const Exchange x(holds_quarter);
-  Halo halo(kNodes, x.send, x.receive, MPI_COMM_WORLD);
+  Halo halo(kNodes, x.send, x.receive, MPI_COMM_WORLD, kGhostTag);
   std::vector<double> v = before_update(x, 3);
   EXPECT_THROW(halo.end_update(v, 3), Error) << "end without begin";
   EXPECT_THROW(halo.update_ghosts(std::span<double>(v).first(v.size() - 1), 3), Error) << "one double short";
