@@ -149,14 +149,7 @@ FractureState FractureStage::part_of(const FractureState& whole) {
     if (whole.bc_mask[w]) bc_rank[w] = bc_nodes++;
   part.bc_index.clear();
   for (Index w : nodes) {
-    s.reference.push_back(whole.reference[w]);
-    s.node_gid.push_back(whole.node_gid[w]);
-    s.node_body.push_back(whole.node_body[w]);
-    s.mass.push_back(whole.mass[w]);
-    s.bc_mask.push_back(whole.bc_mask[w]);
-    s.bc_velocity.push_back(whole.bc_velocity[w]);
-    s.bc_condition.push_back(whole.bc_condition[w]);
-    s.initial_velocity.push_back(whole.initial_velocity[w]);
+    append_node_row(s, whole, w);
     if (whole.bc_mask[w]) part.bc_index.push_back(bc_rank[w]);
   }
   for (Index e = 0; e < mesh.num_elements(); ++e)

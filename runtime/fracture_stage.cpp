@@ -222,15 +222,8 @@ void FractureStage::save(FractureState& s) const {
   // (On a part the outer ghost layer may split without a new revision: the sizes tell.)
   if (s.mesh_revision != mesh.revision || s.reference.size() != static_cast<size_t>(mesh.num_nodes())) {
     s.mesh_revision = mesh.revision;
-    s.reference = mesh.reference;
-    s.node_gid = mesh.node_gid;
-    s.node_body = mesh.node_body;
+    copy_node_arrays(s, model_);
     s.conn = mesh.conn;
-    s.mass = model_.mass;
-    s.bc_mask = model_.bc_mask;
-    s.bc_velocity = model_.bc_velocity;
-    s.bc_condition = model_.bc_condition;
-    s.initial_velocity = model_.initial_velocity;
   }
   s.facet_gid.clear();
   s.facet_state.clear();
@@ -287,17 +280,10 @@ void FractureStage::restore(const FractureState& whole) {
   for (int b : s.node_body)
     SHATTER_REQUIRE(b >= 0 && static_cast<size_t>(b) < model_.scene.bodies.size(), "fracture state: body " << b << " is out of range");
 
-  mesh.reference = s.reference;
-  mesh.node_gid = s.node_gid;
-  mesh.node_body = s.node_body;
+  copy_node_arrays(model_, s);
   mesh.conn = s.conn;
   mesh.build_node_elements();
   mesh.revision = s.mesh_revision;
-  model_.mass = s.mass;
-  model_.bc_mask = s.bc_mask;
-  model_.bc_velocity = s.bc_velocity;
-  model_.bc_condition = s.bc_condition;
-  model_.initial_velocity = s.initial_velocity;
   for (Index f : by_gid_) topology_.facet_state[f] = FacetState::intact;
   for (size_t i = 0; i < open.size(); ++i) topology_.facet_state[open[i]] = s.facet_state[i];
   ++facet_revision_;

@@ -59,6 +59,16 @@ struct FractureState {
   std::vector<Index> cohesive_whole;           ///< [c]: index among the whole model's cohesive elements
 };
 
+/// The state's per-node arrays, in the order of the model's (node_arrays(Model&)).
+inline auto node_arrays(FractureState& s) {
+  return std::tie(s.reference, s.node_gid, s.node_body, s.mass, s.bc_mask, s.bc_velocity, s.bc_condition,
+                  s.initial_velocity);
+}
+inline auto node_arrays(const FractureState& s) {
+  return std::tie(s.reference, s.node_gid, s.node_body, s.mass, s.bc_mask, s.bc_velocity, s.bc_condition,
+                  s.initial_velocity);
+}
+
 class FractureStage {
  public:
   /// The penalty of each material's cohesive law (the steepest unloading

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "contact/surface.hpp"
@@ -94,6 +95,30 @@ void for_each_array(M& m, F f) {
   f(m.bc_velocity), f(m.bc_condition), f(m.load_faces), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
   f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index), f(m.part.surface);
+}
+
+/// The model's per-node arrays that node splitting grows, in one order
+/// (FractureState holds the same: node_arrays there; copy_node_arrays and
+/// append_node_row copy between them).
+inline auto node_arrays(Model& m) {
+  return std::tie(m.mesh.reference, m.mesh.node_gid, m.mesh.node_body, m.mass, m.bc_mask, m.bc_velocity,
+                  m.bc_condition, m.initial_velocity);
+}
+inline auto node_arrays(const Model& m) {
+  return std::tie(m.mesh.reference, m.mesh.node_gid, m.mesh.node_body, m.mass, m.bc_mask, m.bc_velocity,
+                  m.bc_condition, m.initial_velocity);
+}
+/// Every per-node array of `to` becomes that of `from`.
+template <class To, class From>
+void copy_node_arrays(To& to, const From& from) {
+  std::apply([&](auto&... t) { std::apply([&](const auto&... f) { ((t = f), ...); }, node_arrays(from)); },
+             node_arrays(to));
+}
+/// Node n's row of every per-node array of `from`, appended to those of `to`.
+template <class To, class From>
+void append_node_row(To& to, const From& from, Index n) {
+  std::apply([&](auto&... t) { std::apply([&](const auto&... f) { (t.push_back(f[n]), ...); }, node_arrays(from)); },
+             node_arrays(to));
 }
 
 /// Mesh every body, check the meshes, and compute every constant of the model.

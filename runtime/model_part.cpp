@@ -106,14 +106,7 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   mesh.order = wm.order;
   mesh.revision = wm.revision;
   for (Index n : part.node_index) {
-    mesh.reference.push_back(wm.reference[n]);
-    mesh.node_gid.push_back(wm.node_gid[n]);
-    mesh.node_body.push_back(wm.node_body[n]);
-    m.mass.push_back(whole.mass[n]);
-    m.bc_mask.push_back(whole.bc_mask[n]);
-    m.bc_velocity.push_back(whole.bc_velocity[n]);
-    m.bc_condition.push_back(whole.bc_condition[n]);
-    m.initial_velocity.push_back(whole.initial_velocity[n]);
+    append_node_row(m, whole, n);
     if (whole.bc_mask[n]) part.bc_index.push_back(p.bc_index[n]);
     if (two_layers) continue;
     part.node_rank_offsets.push_back(static_cast<Index>(part.node_ranks.size()));
