@@ -298,27 +298,31 @@ void Simulation::apply_fracture() {
                 fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids())))
           : fracture_->gids(fracture_->check(x_, stress6_));
   const Index before = fracture_->cohesive_count();
-  bool inserted = false;
-  Index created = 0;
+  // Insertion is timed without the gather of the new nodes' names (communication).
+  Insertion ins;
+  const std::uint64_t revision = model_.mesh.revision;
   timed(insert_seconds_, insert_cpu_seconds_, [&] {
-    const std::uint64_t revision = model_.mesh.revision;
-    const Insertion ins = fracture_->insert(critical);
-    ledger_.cohesive_elements = fracture_->cohesive_count();
-    if (ledger_.cohesive_elements == before) return;
-    inserted = true;
+    ins = fracture_->insert(critical);
     if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
-    // On parts a rank may split nodes that others do not hold (every rank holding
-    // one splits it alike): the whole model's count decides the forces' update.
-    const auto here = static_cast<Index>(ins.new_nodes.size());
-    created = model_.holds_two_layers() ? number_split_nodes(model_, model_.mesh.num_nodes() - here, revision, *dec_)
-                                        : here;
+  });
+  ledger_.cohesive_elements = fracture_->cohesive_count();
+  if (ledger_.cohesive_elements == before) {
+    // Freed facets' faces join the contact surface.
+    if (contact_ && freed > 0) rebuild_contact_surface();
+    return;
+  }
+  // On parts a rank may split nodes that others do not hold (every rank holding
+  // one splits it alike): the whole model's count decides the forces' update.
+  const auto here = static_cast<Index>(ins.new_nodes.size());
+  Index created = here;
+  if (model_.holds_two_layers())
+    timed(comm_seconds_, [&] { created = number_split_nodes(model_, model_.mesh.num_nodes() - here, revision, *dec_); });
+  timed(insert_seconds_, insert_cpu_seconds_, [&] {
     dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
     // After the node lists: the contact patch asks who owns the new nodes.
     if (contact_ && (freed > 0 || here > 0)) rebuild_contact_surface();
     share_plans();
   });
-  // Freed facets' faces join the contact surface.
-  if (!inserted && contact_ && freed > 0) rebuild_contact_surface();
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
   // unchanged).
