@@ -52,6 +52,7 @@ class H5Handle {
   H5Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
   H5Handle(const H5Handle&) = delete;
   H5Handle& operator=(const H5Handle&) = delete;
+  H5Handle(H5Handle&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
   ~H5Handle() {
     if (id_ >= 0) close_(id_);
   }
@@ -111,6 +112,15 @@ static_assert(sizeof(FacetState) == 1);
 
 // ---- writing: every failure throws Error naming the temporary file ----
 
+/// A creation property list (`cls`: file, group or dataset) without the
+/// objects' time stamps: a checkpoint's bytes are its state's alone, whenever
+/// it is written.
+H5Handle untimed(hid_t cls) {
+  H5Handle p(H5Pcreate(cls), H5Pclose);
+  if (p.valid()) H5Pset_obj_track_times(p.get(), false);
+  return p;
+}
+
 struct Writer {
   std::string path;
   mutable StateDigest digest;
@@ -147,7 +157,8 @@ struct Writer {
     errno = 0;
     H5Handle space(H5Screate_simple(2, dims.data(), nullptr), H5Sclose);
     H5Handle dset(
-        H5Dcreate2(group, name, FileType<T>::file(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+        H5Dcreate2(group, name, FileType<T>::file(), space.get(), H5P_DEFAULT, untimed(H5P_DATASET_CREATE).get(),
+                   H5P_DEFAULT),
         H5Dclose);
     check(space.valid() && dset.valid(), std::string("create dataset ") + name);
     if (!a.empty())
@@ -332,7 +343,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
         fapl.valid() && H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST) >= 0,
         "select the latest file format");
     errno = 0;
-    H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
+    H5Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, untimed(H5P_FILE_CREATE).get(), fapl.get()), H5Fclose);
     w.check(file.valid(), "create the file");
     H5Handle root_group(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose);
     w.check(root_group.valid(), "open the root group");
@@ -360,7 +371,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.attribute(root, "scene_fingerprint", H5T_NATIVE_UINT64, &scene_fp);
     w.integer(root, "history_every", model.scene.history_every);
 
-    H5Handle state(H5Gcreate2(root, "state", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    H5Handle state(H5Gcreate2(root, "state", H5P_DEFAULT, untimed(H5P_GROUP_CREATE).get(), H5P_DEFAULT), H5Gclose);
     w.check(state.valid(), "create group /state");
     w.rows(state.get(), "positions", s.x);
     w.rows(state.get(), "velocities", s.v);
@@ -369,7 +380,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.rows(state.get(), "external_forces", s.f_ext);
     w.rows(state.get(), "reactions", s.reaction);
 
-    H5Handle ledger(H5Gcreate2(root, "ledger", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    H5Handle ledger(H5Gcreate2(root, "ledger", H5P_DEFAULT, untimed(H5P_GROUP_CREATE).get(), H5P_DEFAULT), H5Gclose);
     w.check(ledger.valid(), "create group /ledger");
     const Ledger& l = s.ledger;
     const hid_t g = ledger.get();
@@ -393,7 +404,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 
     if (s.fracture) {
       const FractureState& f = *s.fracture;
-      H5Handle group(H5Gcreate2(root, "fracture", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      H5Handle group(H5Gcreate2(root, "fracture", H5P_DEFAULT, untimed(H5P_GROUP_CREATE).get(), H5P_DEFAULT), H5Gclose);
       w.check(group.valid(), "create group /fracture");
       const hid_t fr = group.get();
       w.integer(fr, "nodes", static_cast<long>(f.reference.size()));
