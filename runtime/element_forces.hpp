@@ -48,7 +48,8 @@ class ElementForces {
 
   /// Compute only `elements` (ascending) from now on, and zero only `nodes`
   /// (ascending: the nodes of those elements) in f_int. Blocks without one
-  /// of them are skipped. Without a call: every element and node.
+  /// of them are skipped. Without a call: every element and node. The
+  /// elements of rigid bodies (BodySpec::any_rigid) are never computed.
   ///
   /// `late_nodes` (any order): nodes whose positions arrive while compute()
   /// runs (a halo exchange between its two phases, see compute). The blocks

@@ -46,6 +46,12 @@ struct BodySpec {
   /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions):
   /// infinite mass in DCR, its contact impulses' work in external_work.
   bool rigid = false;
+  /// bodies[i].rigid: free: a free rigid body, one particle with the mass, centre and inertia
+  /// of its lumped masses (kernels/rigid_body.hpp, runtime/rigid_bodies.hpp): it translates and
+  /// spins under gravity, loads and contact (DCR moves it as a whole); `rigid` stays false.
+  bool free_rigid = false;
+  /// rigid or free_rigid: its elements are never computed (their forces are 0).
+  bool any_rigid() const { return rigid || free_rigid; }
   std::string key;             ///< "bodies[i]", for messages
 };
 
