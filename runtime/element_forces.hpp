@@ -81,6 +81,8 @@ class ElementForces {
                             const std::function<void()>& between = {}) const;
 
   int num_colors() const { return coloring_.num_colors(); }
+  /// Elements compute() computes: those of restrict_to (all without it), less rigid bodies'.
+  Index computed_elements() const { return static_cast<Index>(subset_.size()); }
 
  private:
   void split_phases(const std::vector<char>& late);
