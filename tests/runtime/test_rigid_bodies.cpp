@@ -62,11 +62,9 @@ TEST(RigidBodies, FreeSpinningBoxKeepsMomentaAndEnergy) {
   Simulation sim(m, {});
   const Ledger l0 = sim.ledger();
   const std::vector<Vec3> x0(sim.positions().begin(), sim.positions().end());
-  double L_scale = 0, p_scale = 0;
-  for (Index i = 0; i < m.mesh.num_nodes(); ++i) {
-    L_scale += m.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
-    p_scale += m.mass[i] * sim.velocities()[i].norm();
-  }
+  const double L_scale = test::angular_momentum_scale(sim);
+  double p_scale = 0;
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i) p_scale += m.mass[i] * sim.velocities()[i].norm();
   // omega from two nodes' velocities is awkward; the body's angular velocity comes from
   // the ledger's L about the centre instead: L_c = L - c x p.
   double dE = 0, dL = 0, dp = 0, turned = 0;
@@ -175,9 +173,7 @@ TEST(RigidBodies, RigidDeformableImpactConservesMomenta) {
     std::vector<Vec3> x0;
     for (Index i = 0; i < m.mesh.num_nodes(); ++i)
       if (m.mesh.node_body[i] == 0) x0.push_back(sim.positions()[i]);
-    double L_scale = 0;
-    for (Index i = 0; i < m.mesh.num_nodes(); ++i)
-      L_scale += m.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
+    const double L_scale = test::angular_momentum_scale(sim);
     long contact_steps = 0;
     double dp = 0, dL = 0, dE = 0;
     int penetrations = 0;
