@@ -579,13 +579,13 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   s.energy_scale = r.number(root, "energy_scale");
   H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);
   r.require(state.valid(), "group /state is missing (truncated or corrupted checkpoint?)");
-  const auto free_rigid = static_cast<std::size_t>(std::count_if(
-      model.scene.bodies.begin(), model.scene.bodies.end(), [](const BodySpec& body) { return body.free_rigid; }));
-  if (free_rigid > 0) {
+  const auto rigid = static_cast<std::size_t>(std::count_if(model.scene.bodies.begin(), model.scene.bodies.end(),
+                                                            [](const BodySpec& body) { return body.has_rigid_state(); }));
+  if (rigid > 0) {
     r.require(version >= 6, "the checkpoint is of format version " + std::to_string(version) +
-                                ", before free rigid bodies (version 6)");
-    const std::vector<Vec3> rows = r.rows(state.get(), "rigid_bodies", kRigidRows * free_rigid);
-    for (std::size_t k = 0; k < free_rigid; ++k) s.rigid.push_back(rigid_from_rows(rows.data() + kRigidRows * k));
+                                ", before rigid bodies' states (version 6)");
+    const std::vector<Vec3> rows = r.rows(state.get(), "rigid_bodies", kRigidRows * rigid);
+    for (std::size_t k = 0; k < rigid; ++k) s.rigid.push_back(rigid_from_rows(rows.data() + kRigidRows * k));
   }
   std::size_t b = 0;
   if (model.is_part() && !s.fracture) b = model.part.whole_bc_nodes;

@@ -43,10 +43,11 @@
 //   /state/positions, velocities, accelerations, internal_forces,
 //          external_forces      n x 3 float64 (m, m/s, m/s^2, N, N)
 //   /state/reactions            b x 3 float64, N
-//   /state/rigid_bodies         only with free rigid bodies (bodies[i].rigid: free):
-//       10 rows x 3 float64 per body, in body order (RigidBodyState): (mass kg, 0, 0),
-//       principal moments kg m^2, centre m, velocity m/s, the orientation's three
-//       columns, angular momentum kg m^2/s, force N, torque N m
+//   /state/rigid_bodies         only with rigid bodies that have a state (free ones, and
+//       prescribed ones that spin: BodySpec::has_rigid_state): 10 rows x 3 float64 per
+//       body, in body order (RigidBodyState): (mass kg, 0, 0), principal moments kg m^2,
+//       centre m, velocity m/s, the orientation's three columns, angular momentum
+//       kg m^2/s, force N, torque N m (a prescribed body: moments 1 and L = omega)
 //       each dataset has attribute fnv1a64 (uint64): FNV-1a hash of its bytes,
 //       so a flipped byte in the raw data is found too
 //   /ledger  attributes: the Ledger fields by their history.csv names

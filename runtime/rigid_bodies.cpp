@@ -1,5 +1,7 @@
 #include "runtime/rigid_bodies.hpp"
 
+#include <algorithm>
+
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/loads.hpp"
@@ -13,7 +15,7 @@ std::vector<std::array<double, K>> RigidBodies::body_sums(Term term) const {
   for (const Index i : nodes_)
     if (dec_.owns_node(i)) {
       t.fill(0.0);
-      const int b = node_body_[i];
+      const int b = node_state_[i];
       term(i, b, t);
       for (int k = 0; k < K; ++k) sums[b * K + k] += t[k];
     }
@@ -26,13 +28,21 @@ std::vector<std::array<double, K>> RigidBodies::body_sums(Term term) const {
 
 RigidBodies::RigidBodies(const Model& model, const Decomposition& dec) : model_(model), dec_(dec) {
   const Scene& scene = model.scene;
-  for (const BodySpec& b : scene.bodies) index_.push_back(b.free_rigid ? static_cast<int>(states_.size()) : -1);
-  for (const BodySpec& b : scene.bodies)
-    if (b.free_rigid) states_.emplace_back();
+  for (const BodySpec& b : scene.bodies) {
+    index_.push_back(b.has_rigid_state() ? static_cast<int>(states_.size()) : -1);
+    if (b.has_rigid_state()) {
+      states_.emplace_back();
+      prescribed_.push_back(b.rigid);
+    }
+  }
   const Mesh& mesh = model.mesh;
+  node_state_.assign(mesh.num_nodes(), -1);
   node_body_.assign(mesh.num_nodes(), -1);
   for (Index i = 0; i < mesh.num_nodes(); ++i)
-    if ((node_body_[i] = index_[mesh.node_body[i]]) >= 0) nodes_.push_back(i);
+    if ((node_state_[i] = index_[mesh.node_body[i]]) >= 0) {
+      nodes_.push_back(i);
+      if (!prescribed_[node_state_[i]]) node_body_[i] = node_state_[i];
+    }
   // Mass, centre and momentum; then about the centre the inertia tensor and angular momentum.
   const std::vector<Vec3>& X = mesh.reference;
   const std::vector<Vec3>& v0 = model.initial_velocity;
@@ -58,6 +68,14 @@ RigidBodies::RigidBodies(const Model& model, const Decomposition& dec) : model_(
   });
   for (size_t b = 0; b < states_.size(); ++b) {
     RigidBodyState& s = states_[b];
+    if (prescribed_[b]) {
+      // Its scene's motion, exactly: unit moments and L = omega make omega = J^-1 L.
+      const BodySpec& spec = scene.bodies[std::find(index_.begin(), index_.end(), static_cast<int>(b)) - index_.begin()];
+      s.velocity = spec.initial_velocity;
+      s.inertia = Vec3::Ones();
+      s.angular_momentum = spec.angular_velocity;
+      continue;
+    }
     const auto& t = second[b];
     Mat3 J;
     J << t[0], t[5], t[4], t[5], t[1], t[3], t[4], t[3], t[2];
@@ -67,7 +85,7 @@ RigidBodies::RigidBodies(const Model& model, const Decomposition& dec) : model_(
   }
   arm_.resize(nodes_.size());
   for (size_t k = 0; k < nodes_.size(); ++k) {
-    const RigidBodyState& s = states_[node_body_[nodes_[k]]];
+    const RigidBodyState& s = states_[node_state_[nodes_[k]]];
     arm_[k] = s.orientation.transpose() * (X[nodes_[k]] - s.centre);
   }
   mobility_.resize(states_.size());
@@ -75,7 +93,7 @@ RigidBodies::RigidBodies(const Model& model, const Decomposition& dec) : model_(
 
 void RigidBodies::place(std::span<Vec3> x) const {
   for (size_t k = 0; k < nodes_.size(); ++k) {
-    const RigidBodyState& s = states_[node_body_[nodes_[k]]];
+    const RigidBodyState& s = states_[node_state_[nodes_[k]]];
     x[nodes_[k]] = s.centre + s.orientation * arm_[k];
   }
 }
@@ -84,7 +102,7 @@ void RigidBodies::set_velocities(std::span<const Vec3> x, std::span<Vec3> v) con
   std::vector<Vec3> omega(states_.size());
   for (size_t b = 0; b < states_.size(); ++b) omega[b] = rigid_angular_velocity(states_[b]);
   for (const Index i : nodes_) {
-    const int b = node_body_[i];
+    const int b = node_state_[i];
     v[i] = states_[b].velocity + omega[b].cross(x[i] - states_[b].centre);
   }
 }
@@ -96,14 +114,16 @@ void RigidBodies::predict(double dt, std::span<Vec3> x, std::span<Vec3> v) {
     RigidBodyState& s = states_[b];
     centre_old_[b] = s.centre;
     orientation_old_[b] = s.orientation;
-    s.velocity += (0.5 * dt / s.mass) * s.force;
-    s.angular_momentum += 0.5 * dt * s.torque;
+    if (!prescribed_[b]) {
+      s.velocity += (0.5 * dt / s.mass) * s.force;
+      s.angular_momentum += 0.5 * dt * s.torque;
+    }
     s.centre += dt * s.velocity;
     rigid_free_rotation(s, dt);
   }
   place(x);
   for (size_t k = 0; k < nodes_.size(); ++k) {
-    const int b = node_body_[nodes_[k]];
+    const int b = node_state_[nodes_[k]];
     v[nodes_[k]] = (x[nodes_[k]] - (centre_old_[b] + orientation_old_[b] * arm_[k])) / dt;
   }
 }
@@ -145,7 +165,7 @@ void RigidBodies::apply_contact(std::vector<std::array<ExactSum, kRigidSums>> su
     // The nodes: placed again, with the chord velocity of the prediction plus the impulses' change.
     for (size_t k = 0; k < nodes_.size(); ++k) {
       const Index i = nodes_[k];
-      if (node_body_[i] != static_cast<int>(b)) continue;
+      if (node_state_[i] != static_cast<int>(b)) continue;
       const Vec3 old = centre_old_[b] + orientation_old_[b] * arm_[k];
       const Vec3 predicted = centre_predicted + orientation_predicted * arm_[k];
       x[i] = s.centre + s.orientation * arm_[k];
@@ -173,13 +193,16 @@ void RigidBodies::gather_forces(std::span<const Vec3> x, const SurfaceLoads* loa
     });
   }
   for (size_t b = 0; b < states_.size(); ++b) {
+    if (prescribed_[b]) continue;  // its conditions' reactions take them
     states_[b].force = states_[b].mass * g + Vec3(load[b][0], load[b][1], load[b][2]);
     states_[b].torque = Vec3(load[b][3], load[b][4], load[b][5]);
   }
 }
 
 void RigidBodies::correct(double dt, std::span<const Vec3> x, std::span<Vec3> v) {
-  for (RigidBodyState& s : states_) {
+  for (size_t b = 0; b < states_.size(); ++b) {
+    if (prescribed_[b]) continue;
+    RigidBodyState& s = states_[b];
     s.velocity += (0.5 * dt / s.mass) * s.force;
     s.angular_momentum += 0.5 * dt * s.torque;
   }

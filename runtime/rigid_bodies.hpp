@@ -1,6 +1,12 @@
 #pragma once
-// The free rigid bodies of a scene (bodies[i].rigid: free) in the time loop
-// (docs/physics.md "Free rigid bodies"). Each is one particle with mass M,
+// The rigid bodies of a scene that have a state (BodySpec::has_rigid_state) in
+// the time loop (docs/physics.md "Rigid bodies"): the free ones
+// (bodies[i].rigid: free), and the prescribed ones (rigid: true) that spin.
+// A prescribed body moves with its V and omega for ever: no force, torque or
+// impulse acts on it (its nodes' conditions hold their translation, DCR sees
+// them held: infinite mass), and it is kept as a body with unit principal
+// moments and L = omega, whose free rotation is the exact rotation about
+// omega. A free body is one particle with mass M,
 // centre c and principal inertia I (of its nodes' lumped masses); its nodes sit
 // at x_i = c + R s_i (s_i their arms in the principal frame, fixed) and move
 // with v_i = V + omega x (x_i - c). The body's state is held whole on every
@@ -38,18 +44,22 @@ class SurfaceLoads;
 
 class RigidBodies {
  public:
-  /// The free rigid bodies of `model`: mass, centre and principal inertia from the lumped
-  /// masses, momenta from the nodes' initial velocities (collective over dec's ranks).
+  /// The rigid bodies of `model` with a state: mass and centre from the lumped masses; a
+  /// free body's principal inertia too, and its momenta from the nodes' initial velocities;
+  /// a prescribed one's V and omega from the scene (collective over dec's ranks).
   RigidBodies(const Model& model, const Decomposition& dec);
 
-  /// Per body (of the scene): its index among the free rigid bodies, -1 for others.
+  /// Per body (of the scene): its index into states(), -1 for bodies without a state.
   const std::vector<int>& body_index() const { return index_; }
   const std::vector<RigidBodyState>& states() const { return states_; }
-  /// Per node: its free rigid body (index into states()), -1 for the others.
-  std::span<const std::int32_t> node_body() const { return node_body_; }
+  /// Whether node i belongs to a body with a state (its place and velocity are set here).
+  bool placed(Index i) const { return node_state_[i] >= 0; }
 
   /// Node splitting (fracture of other bodies) made n nodes; the new ones are not rigid.
-  void grow(Index n) { node_body_.resize(n, -1); }
+  void grow(Index n) {
+    node_body_.resize(n, -1);
+    node_state_.resize(n, -1);
+  }
   /// Predictor: the bodies kicked by dt/2 and moved over dt; their nodes placed in x,
   /// with the chord velocity in v.
   void predict(double dt, std::span<Vec3> x, std::span<Vec3> v);
@@ -73,7 +83,7 @@ class RigidBodies {
   void place(std::span<Vec3> x) const;
   /// v_i = V + omega x (x_i - c).
   void set_velocities(std::span<const Vec3> x, std::span<Vec3> v) const;
-  /// Exact sums per body of term(node, body, out[K]) over the nodes this rank owns, over the ranks.
+  /// Exact sums per state of term(node, state, out[K]) over the nodes this rank owns, over the ranks.
   template <int K, class Term>
   std::vector<std::array<double, K>> body_sums(Term term) const;
 
@@ -81,7 +91,9 @@ class RigidBodies {
   const Decomposition& dec_;
   std::vector<int> index_;
   std::vector<RigidBodyState> states_;
-  std::vector<std::int32_t> node_body_;
+  std::vector<char> prescribed_;          ///< per state: a rigid: true body (no force acts on it)
+  std::vector<std::int32_t> node_state_;  ///< per node: its body's state, -1: none
+  std::vector<std::int32_t> node_body_;   ///< per node: its free body's state (DCR's view), -1: none
   std::vector<Index> nodes_;  ///< the nodes of the bodies held here, ascending
   std::vector<Vec3> arm_;     ///< per nodes_: s_i, its arm in the principal frame, m
   std::vector<Vec3> centre_old_;       ///< per body: c(n) during a step

@@ -535,15 +535,9 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
         r.fail(key + ".rigid", "true, false or free", rigid);
       body.rigid = rigid.Scalar() == "true";
       body.free_rigid = rigid.Scalar() == "free";
-      if (body.rigid && (body.angular_velocity != Vec3::Zero() || body.velocity_gradient))
+      if (body.any_rigid() && body.velocity_gradient)
         r.fail(key + ".rigid",
-               "false with angular_velocity or velocity_gradient (rigid: true prescribes a translation; a spinning "
-               "rigid body is rigid: free)",
-               rigid);
-      if (body.free_rigid && body.velocity_gradient)
-        r.fail(key + ".rigid",
-               "false with velocity_gradient (a free rigid body starts with initial_velocity and "
-               "angular_velocity)",
+               "false with velocity_gradient (a rigid body moves with initial_velocity and angular_velocity)",
                rigid);
     }
     s.bodies.push_back(body);

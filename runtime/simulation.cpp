@@ -53,7 +53,8 @@ Simulation::Simulation(Model& model, RunOptions options)
   a_.assign(n, Vec3::Zero());
   f_int_.assign(n, Vec3::Zero());
   f_ext_.assign(n, Vec3::Zero());
-  if (std::any_of(model_.scene.bodies.begin(), model_.scene.bodies.end(), [](const BodySpec& b) { return b.free_rigid; })) {
+  if (std::any_of(model_.scene.bodies.begin(), model_.scene.bodies.end(),
+                  [](const BodySpec& b) { return b.has_rigid_state(); })) {
     rigid_ = std::make_unique<RigidBodies>(model_, *dec_);
     rigid_->place_nodes(x_, v_);
   }
@@ -233,7 +234,13 @@ void Simulation::predict() {
     load_force_old_ = loads_->force();
   }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) { x_[i] += dt_ * v_[i]; });
-  if (rigid_) rigid_->predict(dt_, x_, v_);
+  if (rigid_) {
+    rigid_->predict(dt_, x_, v_);
+    // A spinning prescribed body's nodes: their conditions hold the translation, the
+    // displacement (for the reactions' work) is the body's.
+    for (size_t b = 0; b < bc_nodes_.size(); ++b)
+      if (rigid_->placed(bc_nodes_[b])) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
+  }
 }
 
 void Simulation::resolve_contact() {

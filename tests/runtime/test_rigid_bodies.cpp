@@ -239,3 +239,58 @@ TEST(RigidBodies, GravityAndTractionMoveTheCentreOnTheParabola) {
   EXPECT_LT(dc, 1e-13 * c_scale);
   EXPECT_LT(distance_drift(x0, sim.positions()), 1e-13);
 }
+
+namespace {
+
+// A prescribed rigid steel paddle (rigid: true) of 20 x 4 x 4 mm, spinning about z and
+// moving in x, whose arm strikes a free deformable block 0.3 mm above it.
+std::string paddle_scene() {
+  return std::string("name: paddle\ntime: {end: 1.0}\nmaterials:\n") + kSteel +
+         "bodies:\n"
+         "  - {name: paddle, material: steel, rigid: true, mesh: {shape: box, size: [0.02, 0.004, 0.004], "
+         "center: [0, 0, 0], element_size: 0.002, order: 1}, initial_velocity: [1, 0, 0], angular_velocity: [0, 0, 2000]}\n"
+         "  - {name: block, material: steel, mesh: {shape: box, size: [0.004, 0.004, 0.004], "
+         "center: [0.007, 0.0043, 0], element_size: 0.002, order: 1}}\n"
+         "contact: {friction: 0.0, restitution: 1.0, placement: middle}\n";
+}
+
+}  // namespace
+
+// A prescribed rigid body that spins (rigid: true with angular_velocity) moves with its V
+// and omega for ever: every node at c0 + V t + Rot(omega t) (X - c0) to round-off, however
+// hard the block it strikes pushes back (infinite mass and inertia in DCR); the block is
+// flung off (at ~17 m/s after 600 steps); the ledger, which books the impulses' work on
+// the paddle in external_work (0.15 J), closes within 1 % (measured 0.07 %). Nodes: measured
+// 2.4e-16 m from the exact rotation.
+TEST(RigidBodies, PrescribedSpinningBodyKeepsItsMotionAndFlingsTheBlock) {
+  Model m = build_model(scene_from_text("paddle", paddle_scene()));
+  Simulation sim(m, {});
+  SimulationState s0;
+  sim.save_state(s0);
+  ASSERT_EQ(s0.rigid.size(), 1u);
+  const Vec3 c0 = s0.rigid[0].centre, V(1, 0, 0), w(0, 0, 2000);
+  const Ledger l0 = sim.ledger();
+  double dx = 0, dE = 0;
+  long contact_steps = 0;
+  for (int s = 0; s < 600; ++s) {
+    sim.step();
+    contact_steps += sim.ledger().contacts > 0;
+    dE = std::max(dE, std::abs(sim.ledger().total() - l0.total()));
+    const double t = sim.time();
+    const Mat3 R = Eigen::AngleAxisd(w.norm() * t, w.normalized()).toRotationMatrix();
+    for (Index i = 0; i < m.mesh.num_nodes(); ++i)
+      if (m.mesh.node_body[i] == 0) {
+        dx = std::max(dx, (sim.positions()[i] - (c0 + V * t + R * (m.mesh.reference[i] - c0))).norm());
+        EXPECT_LT((sim.velocities()[i] - (V + w.cross(sim.positions()[i] - c0 - V * t))).norm(), 1e-10);
+      }
+  }
+  const Vec3 vb = test::body_velocity(sim, 1);
+  std::printf("prescribed paddle: %ld contact steps, nodes within %.3g m of the exact rotation, block at (%.3f %.3f "
+              "%.3f) m/s, ledger total moved %.3g of the largest energy, external work %.3g J\n",
+              contact_steps, dx, vb.x(), vb.y(), vb.z(), dE / std::max(l0.kinetic, sim.ledger().kinetic),
+              sim.ledger().external_work);
+  ASSERT_GT(contact_steps, 5);
+  EXPECT_LT(dx, 1e-14);
+  EXPECT_GT(vb.norm(), 1.0);
+  EXPECT_LT(dE, 0.01 * std::max(l0.kinetic, sim.ledger().kinetic));
+}
