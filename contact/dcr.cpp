@@ -29,16 +29,20 @@ DcrPairKind dcr_kind(const ContactPair& p) {
 struct Outcome {
   bool active = false;
   double dissipated = 0, support_work = 0;
+  std::int32_t body = -1;  ///< the rigid body among the pair's nodes, -1: none
+  std::array<double, kRigidSums> rigid{};  ///< what it took (DcrRigidSum)
 };
 
 /// Re-detects the found pair at its turn and resolves it (dcr_resolve_pair), writing its
 /// nodes' new states and moved stamps when it acts.
 Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<const Vec3> x_old, std::span<Vec3> v,
                       std::span<const double> inv_mass, std::span<const std::uint8_t> held_masks, const DcrLaw& law,
-                      double dt, std::vector<long>& moved, long stamp) {
+                      double dt, std::vector<long>& moved, long stamp, const DcrRigidBodies* rigid) {
   const ContactPair& p = found.pair;
   PairPoints X_old, X_new, V, W;
   PairWeights w;
+  PairMobility mobility;
+  std::int32_t body = -1;
   bool held = false, driven = false;  // a held component; one held at a non-zero velocity
   for (int i = 0; i < 4; ++i) {
     const Index n = p.nodes[i];
@@ -46,6 +50,15 @@ Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<c
     X_new.col(i) = x_new[n];
     V.col(i) = v[n];
     w[i] = inv_mass[n];
+    if (rigid && rigid->node_body[n] >= 0) {
+      SHATTER_REQUIRE(body < 0 || body == rigid->node_body[n],
+                      "resolve_contacts: a pair with nodes of two rigid bodies (" << body << ", "
+                                                                                  << rigid->node_body[n] << ")");
+      body = rigid->node_body[n];
+      mobility.rigid[i] = true;
+      mobility.r.col(i) = x_new[n] - rigid->bodies[body].centre;
+      w[i] = 0;
+    }
     const std::uint8_t h = held_masks.empty() ? 0 : held_masks[n];
     for (int c = 0; c < 3; ++c) {
       const bool hc = (h >> c) & 1u;
@@ -55,12 +68,30 @@ Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<c
     }
   }
   const PairPoints V_before = V;
-  const DcrPairResponse out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, W, law, 0.5 * dt)
-                                   : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, w, law, 0.5 * dt);
+  DcrPairResponse out;
+  if (body >= 0) {
+    mobility.w = W;
+    mobility.inv_mass = rigid->bodies[body].inv_mass;
+    mobility.inv_inertia = rigid->bodies[body].inv_inertia;
+    out = dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, mobility, law, 0.5 * dt);
+  } else {
+    out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, W, law, 0.5 * dt)
+               : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, w, law, 0.5 * dt);
+  }
   Outcome o;
   if (!out.active) return o;
   o.active = true;
   o.dissipated = out.impulse.dissipated;
+  if (body >= 0) {
+    o.body = body;
+    for (int i = 0; i < 4; ++i)
+      if (mobility.rigid[i]) {
+        const Vec3 x = X_new.col(i), J = out.impulse.applied.col(i), S = out.shift.col(i);
+        const Vec3 terms[4] = {J, x.cross(J), S, x.cross(S)};
+        for (int t = 0; t < 4; ++t)
+          for (int c = 0; c < 3; ++c) o.rigid[3 * t + c] += terms[t][c];
+      }
+  }
   if (driven) {
     // The free components' kinetic energy change beyond the dissipation came from the supports.
     double gained = 0;
@@ -137,7 +168,8 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass, double dt,
                            const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           DcrRanks* ranks, std::span<const std::uint8_t> held_masks) {
+                           DcrRanks* ranks, std::span<const std::uint8_t> held_masks,
+                           const DcrRigidBodies* rigid) {
   const size_t n_nodes = x_new.size();
   SHATTER_REQUIRE(x_old.size() == n_nodes && v.size() == n_nodes && inv_mass.size() == n_nodes,
                   "resolve_contacts: nodal arrays differ in size (x_new "
@@ -159,7 +191,10 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
   TriangleNormals& tn = scratch.normals;
   if (surface.surface && !mine.empty()) triangle_normals(*surface.surface, x_old, surface.triangles, tn);
 
+  SHATTER_REQUIRE(!rigid || rigid->node_body.size() == n_nodes,
+                  "resolve_contacts: " << rigid->node_body.size() << " rigid body ids for " << n_nodes << " nodes");
   DcrResult result;
+  if (rigid) result.rigid.resize(rigid->bodies.size());
   const int me = ranks ? ranks->rank() : 0;
   ContactPairs resolved;  // every pair resolved here, with repeats
   std::vector<Outcome> outcome;
@@ -257,7 +292,7 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
       tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k != r.end(); ++k)
           outcome[batch[k]] = resolve_found(found[batch[k]], x_new, x_old, v, inv_mass, held_masks, law, dt,
-                                            scratch.moved, stamp);
+                                            scratch.moved, stamp, rigid);
       });
       for (const Index f : batch) {
         ++done;
@@ -288,6 +323,8 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
         resolved.push_back(found[f].pair);
         result.dissipated += outcome[f].dissipated;
         result.support_work += outcome[f].support_work;
+        if (outcome[f].body >= 0)
+          for (int t = 0; t < kRigidSums; ++t) result.rigid[outcome[f].body][t] += outcome[f].rigid[t];
       }
     if (result.sweeps == options.max_sweeps) {
       result.capped = true;

@@ -31,6 +31,23 @@ struct DcrOptions {
   DcrPlacement placement = DcrPlacement::End;  ///< where in the step a collision is placed (DcrLaw)
 };
 
+/// The free rigid bodies (bodies[i].rigid: free) among the nodes: DCR moves each as one
+/// particle with mass and inertia (PairMobility), and reports what it gave each one.
+struct DcrRigidBodies {
+  struct Body {
+    double inv_mass = 0;              ///< 1/M, 1/kg
+    Mat3 inv_inertia = Mat3::Zero();  ///< J^-1 in the world frame, 1/(kg m^2)
+    Vec3 centre = Vec3::Zero();       ///< c, m (the arms r = x - c)
+  };
+  std::span<const std::int32_t> node_body;  ///< per node: its body (index into bodies), -1: deformable
+  std::span<const Body> bodies;
+};
+
+/// Per rigid body, what the pairs gave it (DcrResult::rigid), about the origin: impulse
+/// sum J_a (N s), angular impulse sum x_a x J_a (N m s), mass-weighted shift sum S_a (kg m)
+/// and its moment sum x_a x S_a (kg m^2), x_a the node's position after its pair.
+enum DcrRigidSum { kRigidImpulse = 0, kRigidAngularImpulse = 3, kRigidShift = 6, kRigidShiftMoment = 9, kRigidSums = 12 };
+
 /// Summary of one call of resolve_contacts.
 struct DcrResult {
   // On several ranks contacts, dissipated, support_work, unresolved and detected are this
@@ -45,6 +62,8 @@ struct DcrResult {
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
   std::optional<ContactPair> unresolved;  ///< when capped: the first pair (canonical order) found in the last round
   Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds
+  /// Per rigid body (DcrRigidBodies::bodies; empty without), this rank's pairs' DcrRigidSum terms.
+  std::vector<std::array<ExactSum, kRigidSums>> rigid;
 };
 
 /// A pair found penetrating, with the outward normals that orient it (pair_normals at x_old,
@@ -124,6 +143,9 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 ///   held      per node (empty: none), bit k set = component k held by a boundary condition:
 ///             such a node moves only in its free components (its mass counts as infinite
 ///             in the held ones: weighted() in kernels/dcr.hpp); held in all three, never.
+///   rigid     (null: none) the free rigid bodies: a pair's nodes of one body move with it
+///             (PairMobility; their inv_mass is not read), and DcrResult::rigid gets the
+///             impulses and shifts the body takes. A pair may hold nodes of one rigid body only.
 /// mine: the candidate pairs this rank checks (on one rank, all of them), in canonical order.
 /// The work goes in rounds:
 ///   1. detection, in parallel, reading only: in the first round each pair of mine whose swept
@@ -144,6 +166,7 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
 DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_new,
                            std::span<const Vec3> x_old, std::span<Vec3> v, std::span<const double> inv_mass,
                            double dt, const DcrOptions& options, const DcrSurface& surface, DcrScratch& scratch,
-                           DcrRanks* ranks = nullptr, std::span<const std::uint8_t> held = {});
+                           DcrRanks* ranks = nullptr, std::span<const std::uint8_t> held = {},
+                           const DcrRigidBodies* rigid = nullptr);
 
 }  // namespace shatter

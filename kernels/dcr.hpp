@@ -65,6 +65,33 @@ PairPoints weighted(const PairPoints& G, const Eigen::MatrixBase<Derived>& w) {
   }
 }
 
+/// The inverse mass of a pair whose nodes may belong to one free rigid body (a "mobility":
+/// the velocity change of every node under impulses on the pair's nodes). The deformable
+/// nodes as weighted() above (w, per node and component; its columns of the rigid nodes are
+/// not read); the nodes with rigid[i] move with the body: impulses J_a on them give the body
+/// dP = sum_a J_a, dL = sum_a r_a x J_a, hence node i the velocity change
+///   D_i = dP / M + (J^-1 dL) x r_i,   r_i = x_i - c
+/// (inv_mass = 1/M, inv_inertia = J^-1 in the world frame, r the nodes' arms). The mobility
+/// is symmetric and positive: G . D = |sum G_a|^2 / M + (sum r_a x G_a) . J^-1 (sum r_a x G_a).
+struct PairMobility {
+  PairPoints w = PairPoints::Zero();  ///< deformable nodes: inverse mass per component, 1/kg
+  std::array<bool, 4> rigid{};        ///< the node moves with the rigid body
+  double inv_mass = 0;                ///< 1/M of the rigid body, 1/kg
+  Mat3 inv_inertia = Mat3::Zero();    ///< J^-1 (world frame), 1/(kg m^2)
+  PairPoints r = PairPoints::Zero();  ///< per rigid node: x_i - c, m
+};
+
+inline PairPoints weighted(const PairPoints& G, const PairMobility& m) {
+  PairPoints D = G.cwiseProduct(m.w);
+  Vec3 P = Vec3::Zero(), L = Vec3::Zero();
+  for (int i = 0; i < 4; ++i)
+    if (m.rigid[i]) P += G.col(i), L += m.r.col(i).cross(G.col(i));
+  const Vec3 omega = m.inv_inertia * L;
+  for (int i = 0; i < 4; ++i)
+    if (m.rigid[i]) D.col(i) = m.inv_mass * P + omega.cross(m.r.col(i));
+  return D;
+}
+
 enum class DcrPairKind : std::uint8_t { VertexFace = 0, EdgeEdge = 1 };
 
 /// Where in the step dcr_resolve_pair places a collision (scene key contact.placement).
@@ -359,9 +386,11 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// does not move) and nodes with W_i = 0 stay put. When the cubic has no root in reach,
 /// the step goes to its maximum and the gradient is re-evaluated at X (at most 4 passes).
 /// Returns whether g(X) > 0 afterwards (false e.g. when all four nodes are fixed).
+/// `shift` (if any) accumulates the mass-weighted displacements mu grad g (kg m), the
+/// projection's "impulse" on each node (a rigid body moves by it: PairMobility).
 template <class Weights>
 bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
-                 const Weights& inv_mass, double gap) {
+                 const Weights& inv_mass, double gap, PairPoints* shift = nullptr) {
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
@@ -383,6 +412,7 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
       if (g(br[k + 1]) > g(mu)) mu = br[k + 1];
     }
     X += mu * D;
+    if (shift) *shift += mu * G;
     if (g(mu) >= 0.0) break;
   }
   return s * pair_volume(X) > 0.0;
@@ -394,6 +424,7 @@ struct DcrImpulse {
   double friction = 0.0;    ///< |slide impulse| on the vertex / on edge a, N s
   double dissipated = 0.0;  ///< kinetic energy lost, J (>= 0; 0 for e = 1, mu = 0)
   bool stick = false;       ///< friction stopped the sliding
+  PairPoints applied = PairPoints::Zero();  ///< the impulse on each node (columns), N s; they sum to 0
 };
 
 /// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
@@ -423,6 +454,7 @@ DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X
   if (!(v_n < 0.0)) return out;  // already separating
   const double e = law.restitution;
   V -= ((1.0 + e) * v_n) * D;
+  out.applied = (-(1.0 + e) * v_n) * G;
   out.dissipated = 0.5 * (1.0 - e * e) * v_n * v_n * q;
   const int side_a = kind == DcrPairKind::VertexFace ? 1 : 2;  // nodes 0..side_a-1
   const Vec3 G_a = G.leftCols(side_a).rowwise().sum();
@@ -478,6 +510,7 @@ DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X
   out.stick = v_s <= j_max;
   const double j = out.stick ? v_s : j_max;
   V -= j * DF;
+  out.applied -= j * F;
   out.friction = j * F_a;
   out.dissipated += j * qf * (v_s - 0.5 * j);
   return out;
@@ -488,6 +521,9 @@ struct DcrPairResponse {
   bool active = false;  ///< the pair penetrated and was resolved
   bool separated = false;  ///< the projection reached g > 0
   DcrImpulse impulse;
+  /// The mass-weighted position change of each node, kg m: the projections' mu grad g and
+  /// the free flight's tau times the impulse (Middle, Impact); they sum to 0.
+  PairPoints shift = PairPoints::Zero();
 };
 
 /// One DCR resolution of a pair over a step of the central-difference predictor
@@ -523,7 +559,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   const double s = pen.orientation;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
   if (law.placement == DcrPlacement::End) {
-    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap);
+    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift);
     out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
     return out;
   }
@@ -533,6 +569,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   const PairPoints V_before = V;
   out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law);
   X_new += tau * (V - V_before);
+  out.shift = tau * out.impulse.applied;
   // What is left is projected, to no less than twice the touching tolerance and, in the
   // middle, to no more than half the separation the pair had at the start of the step (an
   // elastic impulse at X_mid brings a pair back to it, so the projection takes up only what
@@ -545,7 +582,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
           ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
           : touch;
   out.separated = s * pair_volume(X_new) >= target ||
-                  dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit);
+                  dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift);
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <csignal>
@@ -21,8 +22,29 @@ namespace {
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
 
 constexpr const char* kFormat = "shatter-checkpoint";
-// 2: the step controller's state; 3: the scene's physics keys; 4: the ledger's contact_work
-constexpr long kVersion = 5;
+// 2: the step controller's state; 3: the scene's physics keys; 4: the ledger's contact_work;
+// 6: the free rigid bodies' states
+constexpr long kVersion = 6;
+/// Rows (Vec3) per free rigid body in /state/rigid_bodies.
+constexpr std::size_t kRigidRows = 10;
+
+/// A free rigid body's state as kRigidRows rows: (mass, 0, 0), principal moments, centre,
+/// velocity, the orientation's columns, angular momentum, force, torque.
+void rigid_rows(const RigidBodyState& b, std::vector<Vec3>& rows) {
+  rows.push_back(Vec3(b.mass, 0, 0));
+  for (const Vec3& v : {b.inertia, b.centre, b.velocity}) rows.push_back(v);
+  for (int c = 0; c < 3; ++c) rows.push_back(b.orientation.col(c));
+  for (const Vec3& v : {b.angular_momentum, b.force, b.torque}) rows.push_back(v);
+}
+
+RigidBodyState rigid_from_rows(const Vec3* r) {
+  RigidBodyState b;
+  b.mass = r[0].x();
+  b.inertia = r[1], b.centre = r[2], b.velocity = r[3];
+  for (int c = 0; c < 3; ++c) b.orientation.col(c) = r[4 + c];
+  b.angular_momentum = r[7], b.force = r[8], b.torque = r[9];
+  return b;
+}
 constexpr long kOldestVersion = 2;  // read without the physics check
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
@@ -379,6 +401,11 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
     w.rows(state.get(), "internal_forces", s.f_int);
     w.rows(state.get(), "external_forces", s.f_ext);
     w.rows(state.get(), "reactions", s.reaction);
+    if (!s.rigid.empty()) {
+      std::vector<Vec3> rows;
+      for (const RigidBodyState& b : s.rigid) rigid_rows(b, rows);
+      w.rows(state.get(), "rigid_bodies", rows);
+    }
 
     H5Handle ledger(H5Gcreate2(root, "ledger", H5P_DEFAULT, untimed(H5P_GROUP_CREATE).get(), H5P_DEFAULT), H5Gclose);
     w.check(ledger.valid(), "create group /ledger");
@@ -563,6 +590,14 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   s.energy_scale = r.number(root, "energy_scale");
   H5Handle state(H5Gopen2(root, "state", H5P_DEFAULT), H5Gclose);
   r.require(state.valid(), "group /state is missing (truncated or corrupted checkpoint?)");
+  const auto rigid = static_cast<std::size_t>(std::count_if(model.scene.bodies.begin(), model.scene.bodies.end(),
+                                                            [](const BodySpec& body) { return body.has_rigid_state(); }));
+  if (rigid > 0) {
+    r.require(version >= 6, "the checkpoint is of format version " + std::to_string(version) +
+                                ", before rigid bodies' states (version 6)");
+    const std::vector<Vec3> rows = r.rows(state.get(), "rigid_bodies", kRigidRows * rigid);
+    for (std::size_t k = 0; k < rigid; ++k) s.rigid.push_back(rigid_from_rows(rows.data() + kRigidRows * k));
+  }
   std::size_t b = 0;
   if (model.is_part() && !s.fracture) b = model.part.whole_bc_nodes;
   else for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;

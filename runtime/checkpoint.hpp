@@ -10,7 +10,8 @@
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
-//       version       int64 5 (4: /fracture's facets by index, refused with
+//       version       int64 6 (5: without free rigid bodies, refused with them;
+//                     4: /fracture's facets by index, refused with
 //                     fracture; 3: without the ledger's contact_work; 2: without
 //                     physics, scene_fingerprint and history_every, read without
 //                     the physics check; 1: before the step controller, refused)
@@ -42,6 +43,11 @@
 //   /state/positions, velocities, accelerations, internal_forces,
 //          external_forces      n x 3 float64 (m, m/s, m/s^2, N, N)
 //   /state/reactions            b x 3 float64, N
+//   /state/rigid_bodies         only with rigid bodies that have a state (free ones, and
+//       prescribed ones that spin: BodySpec::has_rigid_state): 10 rows x 3 float64 per
+//       body, in body order (RigidBodyState): (mass kg, 0, 0), principal moments kg m^2,
+//       centre m, velocity m/s, the orientation's three columns, angular momentum
+//       kg m^2/s, force N, torque N m (a prescribed body: moments 1 and L = omega)
 //       each dataset has attribute fnv1a64 (uint64): FNV-1a hash of its bytes,
 //       so a flipped byte in the raw data is found too
 //   /ledger  attributes: the Ledger fields by their history.csv names

@@ -29,6 +29,8 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   options_.placement = spec.placement;
   body_pairs_ = spec.pairs;
   self_ = spec.self;
+  for (const BodySpec& b : model.scene.bodies) free_rigid_.push_back(b.free_rigid);
+  any_free_rigid_ = std::find(free_rigid_.begin(), free_rigid_.end(), char{1}) != free_rigid_.end();
   // A part of the model brings the whole model's surface.
   if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
   else rebuild(model.mesh);
@@ -56,9 +58,12 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 
 bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
-  if (!body_pairs_.empty() || !self_) {
+  if (!body_pairs_.empty() || !self_ || any_free_rigid_) {
     const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
     if (!self_ && a == b) return true;
+    // Free rigid bodies touch deformable ones only (DCR moves one rigid body per pair;
+    // the scene refuses two that contact.pairs lets touch): their self-pairs drop.
+    if (free_rigid_[a] && free_rigid_[b]) return true;
     if (!body_pairs_.empty() &&
         !std::binary_search(body_pairs_.begin(), body_pairs_.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)}))
       return true;
@@ -82,7 +87,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   }
   have_candidates_ = false;
   pairs_.clear();
-  if (!body_pairs_.empty() || !self_) node_body_ = mesh.node_body;
+  if (!body_pairs_.empty() || !self_ || any_free_rigid_) node_body_ = mesh.node_body;
   if (!dec_) return;
   triangle_order_.resize(surface_.triangles.size());
   std::iota(triangle_order_.begin(), triangle_order_.end(), 0);
@@ -269,7 +274,8 @@ ContactPairs ContactStage::active_pairs() const {
 }
 
 DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                              std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held) {
+                              std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held,
+                              const DcrRigidBodies* rigid) {
   using clock = std::chrono::steady_clock;
   // Each phase's wall time, less the exchanges within it (counted apart).
   auto lap = [this, last = clock::now(), exchanged = profile_.exchange_seconds](double& seconds) mutable {
@@ -290,7 +296,8 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   const double cpu0 = thread_cpu_seconds();
   const long bytes0 = dec_ ? ranks_->bytes() : 0, posted0 = dec_ ? ranks_->posted() : 0;
   const double wait0 = dec_ ? ranks_->seconds() : 0, wait_cpu0 = dec_ ? ranks_->cpu_seconds() : 0;
-  DcrResult r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, ranks_.get(), held);
+  DcrResult r =
+      resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, ranks_.get(), held, rigid);
   double wait_cpu = 0;
   if (dec_) {
     const long bytes = ranks_->bytes() - bytes0;

@@ -92,9 +92,11 @@ class ContactStage {
   /// gets its final state on every rank that touches it or holds it in its patch.
   /// The result's contacts, dissipated and support_work are then this rank's part;
   /// when capped, unresolved is the first pair over all ranks (and its nodes' x_new
-  /// are written here).
+  /// are written here). rigid (null: none): the free rigid bodies (resolve_contacts); the
+  /// result's rigid sums are this rank's part.
   DcrResult apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
-                  std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {});
+                  std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {},
+                  const DcrRigidBodies* rigid = nullptr);
 
   /// Rebuild the surface after fracture split nodes or freed facets: crack faces
   /// whose sides no longer share nodes join it, but those in `skip` ((element,
@@ -129,8 +131,8 @@ class ContactStage {
   void set_surface(ContactSurface surface, const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   /// Whether the pair is left out: its primitives share a node, twins counted as one
-  /// (rebuild), its bodies are not a pair of contact.pairs, or they are one body and
-  /// contact.self is false.
+  /// (rebuild), its bodies are not a pair of contact.pairs, they are one body and
+  /// contact.self is false, or both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
@@ -156,6 +158,8 @@ class ContactStage {
   std::vector<Index> twin_of_;  ///< per node, its twins' representative (the smallest id); empty: no twins
   std::vector<std::array<int, 2>> body_pairs_;  ///< contact.pairs (empty: all)
   bool self_ = true;                            ///< contact.self
+  std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free
+  bool any_free_rigid_ = false;
   std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;

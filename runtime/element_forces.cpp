@@ -129,7 +129,15 @@ double ElementForces::granule_energy(Index granule) const {
 
 void ElementForces::set_subset(std::span<const Index> elements) {
   const Index nblocks = static_cast<Index>(blocks_.size());
-  subset_.assign(elements.begin(), elements.end());
+  // Rigid bodies' elements are never computed: their forces are 0 (runtime/rigid_bodies.hpp).
+  const std::vector<BodySpec>& bodies = model_.scene.bodies;
+  auto rigid = [&](Index e) {
+    const int b = model_.mesh.elem_body[e];
+    return b >= 0 && static_cast<size_t>(b) < bodies.size() && bodies[b].any_rigid();
+  };
+  subset_.clear();
+  for (const Index e : elements)
+    if (!rigid(e)) subset_.push_back(e);
   subset_offsets_.assign(nblocks + 1, 0);
   for (Index e : subset_) ++subset_offsets_[block_of(e) + 1];
   for (Index b = 0; b < nblocks; ++b) subset_offsets_[b + 1] += subset_offsets_[b];

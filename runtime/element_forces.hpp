@@ -48,7 +48,8 @@ class ElementForces {
 
   /// Compute only `elements` (ascending) from now on, and zero only `nodes`
   /// (ascending: the nodes of those elements) in f_int. Blocks without one
-  /// of them are skipped. Without a call: every element and node.
+  /// of them are skipped. Without a call: every element and node. The
+  /// elements of rigid bodies (BodySpec::any_rigid) are never computed.
   ///
   /// `late_nodes` (any order): nodes whose positions arrive while compute()
   /// runs (a halo exchange between its two phases, see compute). The blocks
@@ -80,6 +81,8 @@ class ElementForces {
                             const std::function<void()>& between = {}) const;
 
   int num_colors() const { return coloring_.num_colors(); }
+  /// Elements compute() computes: those of restrict_to (all without it), less rigid bodies'.
+  Index computed_elements() const { return static_cast<Index>(subset_.size()); }
 
  private:
   void split_phases(const std::vector<char>& late);

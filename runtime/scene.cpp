@@ -535,10 +535,13 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     if (b["angular_velocity"]) body.angular_velocity = r.vec3(b["angular_velocity"], key + ".angular_velocity");
     if (b["velocity_gradient"]) body.velocity_gradient = r.mat3(b["velocity_gradient"], key + ".velocity_gradient");
     if (const YAML::Node rigid = b["rigid"]) {
-      body.rigid = r.flag(rigid, key + ".rigid");
-      if (body.rigid && (body.angular_velocity != Vec3::Zero() || body.velocity_gradient))
+      if (!rigid.IsScalar() || (rigid.Scalar() != "true" && rigid.Scalar() != "false" && rigid.Scalar() != "free"))
+        r.fail(key + ".rigid", "true, false or free", rigid);
+      body.rigid = rigid.Scalar() == "true";
+      body.free_rigid = rigid.Scalar() == "free";
+      if (body.any_rigid() && body.velocity_gradient)
         r.fail(key + ".rigid",
-               "false with angular_velocity or velocity_gradient (a rigid body translates; rotation is not built yet)",
+               "false with velocity_gradient (a rigid body moves with initial_velocity and angular_velocity)",
                rigid);
     }
     s.bodies.push_back(body);
@@ -580,6 +583,11 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
         }
       if (!any) r.fail(vk, "at least one prescribed (non-null) component", v);
       if (c["amplitude"]) bc.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
+      if (s.bodies[bc.body].free_rigid)
+        r.fail(key + ".body",
+               "a body that is not rigid: free (a free rigid body moves by its momenta; rigid: true prescribes its "
+               "velocity)",
+               c["body"]);
       s.boundary_conditions.push_back(bc);
     }
   }
@@ -662,9 +670,20 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
                                        : DcrPlacement::Impact;
       }
     }
+    for (std::size_t a = 0; a < s.bodies.size(); ++a)
+      for (std::size_t b = a + 1; b < s.bodies.size(); ++b)
+        if (s.bodies[a].free_rigid && s.bodies[b].free_rigid &&
+            (cs.pairs.empty() || std::binary_search(cs.pairs.begin(), cs.pairs.end(),
+                                                    std::array<int, 2>{static_cast<int>(a), static_cast<int>(b)})))
+          r.fail("contact.pairs",
+                 "the free rigid bodies '" + s.bodies[a].name + "' and '" + s.bodies[b].name +
+                     "' may touch; list the pairs that touch without theirs (DCR moves one rigid body per pair)");
     s.contact = cs;
   }
   if (root["gravity"]) s.gravity = r.vec3(root["gravity"], "gravity");
+  if (!s.fixed_dt && std::all_of(s.bodies.begin(), s.bodies.end(), [](const BodySpec& b) { return b.any_rigid(); }))
+    r.fail("time.dt", "missing, but every body is rigid and rigid bodies' elements set no stable step: give a "
+                      "fixed step");
   if (const YAML::Node c = root["checkpoint"]) {
     r.only_keys(c, "checkpoint", {"every_steps", "every_seconds"});
     CheckpointSpec cp;

@@ -42,10 +42,20 @@ struct BodySpec {
   Vec3 initial_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Mat3> velocity_gradient;
-  /// bodies[i].rigid: the body moves with its initial velocity for ever (a condition
-  /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions):
-  /// infinite mass in DCR, its contact impulses' work in external_work.
+  /// bodies[i].rigid: true: the body moves with its initial velocity for ever (a condition
+  /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions),
+  /// spinning at angular_velocity about its centre of mass (runtime/rigid_bodies.hpp places
+  /// its nodes): infinite mass in DCR, its contact impulses' work in external_work.
   bool rigid = false;
+  /// bodies[i].rigid: free: a free rigid body, one particle with the mass, centre and inertia
+  /// of its lumped masses (kernels/rigid_body.hpp, runtime/rigid_bodies.hpp): it translates and
+  /// spins under gravity, loads and contact (DCR moves it as a whole); `rigid` stays false.
+  bool free_rigid = false;
+  /// rigid or free_rigid: its elements are never computed (their forces are 0).
+  bool any_rigid() const { return rigid || free_rigid; }
+  /// A rigid body whose state RigidBodies keeps: a free one, or a prescribed one that spins
+  /// (a prescribed translation alone is its condition's).
+  bool has_rigid_state() const { return free_rigid || (rigid && angular_velocity != Vec3::Zero()); }
   std::string key;             ///< "bodies[i]", for messages
 };
 

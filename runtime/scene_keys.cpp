@@ -132,6 +132,8 @@ std::string physics_keys(const Scene& s) {
     w.integer(b.key + ".mesh.order", b.shape.order);
     w.vec3(b.key + ".initial_velocity", b.initial_velocity);
     w.vec3(b.key + ".angular_velocity", b.angular_velocity);
+    // rigid: true is its condition's keys; free only where set (older checkpoints' texts stay equal).
+    if (b.free_rigid) w.text(b.key + ".rigid", "free");
     if (b.velocity_gradient)
       for (int i = 0; i < 3; ++i)
         w.vec3(b.key + ".velocity_gradient[" + std::to_string(i) + "]", b.velocity_gradient->row(i).transpose());

@@ -17,6 +17,7 @@
 #include "runtime/loads.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
+#include "runtime/rigid_bodies.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -53,6 +54,11 @@ Simulation::Simulation(Model& model, RunOptions options)
   a_.assign(n, Vec3::Zero());
   f_int_.assign(n, Vec3::Zero());
   f_ext_.assign(n, Vec3::Zero());
+  if (std::any_of(model_.scene.bodies.begin(), model_.scene.bodies.end(),
+                  [](const BodySpec& b) { return b.has_rigid_state(); })) {
+    rigid_ = std::make_unique<RigidBodies>(model_, *dec_);
+    rigid_->place_nodes(x_, v_);
+  }
   if (model_.scene.contact) {
     contact_ = std::make_unique<ContactStage>(model_, *model_.scene.contact, dec_.get());
     count_contact_vertices();
@@ -163,6 +169,7 @@ void Simulation::compute_forces(long step, double time, const std::function<void
         reaction_[b][c] = 0.0;
       }
   }
+  if (rigid_) rigid_->gather_forces(x_, loads_.get());
 }
 
 void Simulation::step() {
@@ -228,6 +235,13 @@ void Simulation::predict() {
     load_force_old_ = loads_->force();
   }
   dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) { x_[i] += dt_ * v_[i]; });
+  if (rigid_) {
+    rigid_->predict(dt_, x_, v_);
+    // A spinning prescribed body's nodes: their conditions hold the translation, the
+    // displacement (for the reactions' work) is the body's.
+    for (size_t b = 0; b < bc_nodes_.size(); ++b)
+      if (rigid_->placed(bc_nodes_[b])) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
+  }
 }
 
 void Simulation::resolve_contact() {
@@ -236,7 +250,9 @@ void Simulation::resolve_contact() {
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
   for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
-  const DcrResult r = contact_->apply(x_prev_, x_, v_, inv_mass_, dt_, model_.bc_mask);
+  const DcrResult r =
+      contact_->apply(x_prev_, x_, v_, inv_mass_, dt_, model_.bc_mask, rigid_ ? &rigid_->for_contact() : nullptr);
+  if (rigid_) rigid_->apply_contact(r.rigid, dt_, x_, v_);
   for (size_t k = 0; k < vertices.size(); ++k) {
     contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
     contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
@@ -280,6 +296,7 @@ void Simulation::book_contact_work() {
 
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
   half_kick(false);
+  if (rigid_) rigid_->correct(dt_, x_, v_);
   // The reactions' work by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
   for (size_t b = 0; b < bc_nodes_.size(); ++b)
     if (dec_->owns_node(bc_nodes_[b]))
@@ -377,11 +394,13 @@ void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) 
   recompute_node_masses(model_, touched);
   for (Index i : touched) inv_mass_[i] = 1.0 / model_.mass[i];
   if (loads_) loads_->rebuild();
+  if (rigid_) rigid_->grow(n);
 }
 
 void Simulation::node_arrays_from_model() {
   const Index n = model_.mesh.num_nodes();
   inv_mass_.resize(n);
+  if (rigid_) rigid_->grow(n);
   bc_nodes_.clear();
   for (Index i = 0; i < n; ++i) {
     inv_mass_[i] = 1.0 / model_.mass[i];

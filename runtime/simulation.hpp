@@ -26,6 +26,7 @@
 
 #include "runtime/element_forces.hpp"
 #include "kernels/exact_sum.hpp"
+#include "kernels/rigid_body.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/ledger.hpp"
 #include "runtime/model.hpp"
@@ -38,6 +39,7 @@ class FailureChannel;
 class CsvWriter;
 class ContactStage;
 class SurfaceLoads;
+class RigidBodies;
 class Decomposition;
 struct DecompositionStats;
 struct ContactBalance;
@@ -73,6 +75,7 @@ struct SimulationState {
   Ledger ledger;
   double total0 = 0, energy_scale = 0;  ///< J: energy_error()'s reference
   std::optional<FractureState> fracture;  ///< scenes with fracture: the mesh after splits, cohesive elements
+  std::vector<RigidBodyState> rigid;      ///< the free rigid bodies (RigidBodies), in body order
   /// The model as built, before fracture changed its mesh: model_fingerprint()
   /// and node count, by which a checkpoint names its model.
   std::uint64_t model_fingerprint = 0;
@@ -225,6 +228,7 @@ class Simulation {
   std::vector<Vec3> bc_dx_;            ///< per bc node: its displacement over the step under way, m
   std::vector<double> bc_factor_;      ///< per boundary condition: its values' factor at the half step under way
   std::unique_ptr<SurfaceLoads> loads_;  ///< null without loads
+  std::unique_ptr<RigidBodies> rigid_;   ///< null without free rigid bodies
   std::vector<Vec3> load_x_old_, load_force_old_;  ///< per loaded node: x(n) and its load at x(n), for the work
   double time_ = 0, dt_ = 0, stable_dt_ = 0;
   StepControl step_control_;

@@ -176,9 +176,10 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("wall_time", wall);
   j.add("time_per_step", step_ > 0 ? wall / step_ : 0.0);
   j.add("element_loop_time", element_seconds_);
-  // element-steps per second per core spent in the element loop
+  // element-steps per second per core spent in the element loop (the elements computed: not rigid bodies')
   j.add("element_updates_per_second",
-        element_seconds_ > 0 ? double(dec_->local_elements().size()) * (step_ + 1) / (element_seconds_ * opt_.threads) : 0.0);
+        element_seconds_ > 0 ? double(elements_.computed_elements()) * (step_ + 1) / (element_seconds_ * opt_.threads)
+                             : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
   j.add("peak_memory_bytes_per_rank", memory.first);
   j.add("model_bytes_per_rank_max", memory.second);

@@ -13,6 +13,7 @@
 #include "runtime/simulation.hpp"
 
 #include "runtime/loads.hpp"
+#include "runtime/rigid_bodies.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -79,6 +80,7 @@ void Simulation::save_state(SimulationState& s) const {
   s.energy_scale = energy_scale_;
   s.model_fingerprint = model_fingerprint_;
   s.model_nodes = model_nodes_;
+  s.rigid = rigid_ ? rigid_->states() : std::vector<RigidBodyState>{};
   if (fracture_) {
     if (!s.fracture) s.fracture.emplace();
     fracture_->save(*s.fracture);
@@ -121,6 +123,9 @@ void Simulation::restore_state(const SimulationState& s) {
   f_int_ = rows(s.f_int, model_.part.node_index);
   f_ext_ = rows(s.f_ext, model_.part.node_index);
   reaction_ = rows(s.reaction, model_.part.bc_index);
+  SHATTER_REQUIRE(s.rigid.empty() || rigid_, "restore_state: the state has " << s.rigid.size()
+                                                                           << " free rigid bodies, the scene none");
+  if (rigid_) rigid_->restore(s.rigid, x_, v_);
   restore_scalars(s);
   if (loads_) {
     // The loads at x(n), which the next step's work starts from.

@@ -36,6 +36,16 @@ inline Vec3 body_centre(const Simulation& sim, int b) {
   return body_mean(sim, b, sim.positions());
 }
 
+/// sum m |x| |v| over the nodes, kg m^2/s: the scale of the angular momentum about the
+/// origin against which its changes are measured.
+inline double angular_momentum_scale(const Simulation& sim) {
+  const Model& m = sim.model();
+  double scale = 0;
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
+    scale += m.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
+  return scale;
+}
+
 /// The number of surface vertices of each body that lie inside a tetrahedron of another
 /// body by more than `depth` times that tetrahedron's smallest altitude (all four
 /// barycentric coordinates above `depth`). Brute force over the volume meshes (corner

@@ -243,6 +243,17 @@ TEST(Checkpoint, RestoredContactRunIsBitwiseTheUninterruptedOne) {
   EXPECT_GT(contacts, 0) << "the scene must be in contact after the checkpoint";
 }
 
+// A free rigid block, spinning, sliding onto the clamped plate under gravity: its state
+// (centre, velocity, orientation, angular momentum, force, torque) is in the checkpoint.
+TEST(Checkpoint, RestoredRigidBodyRunIsBitwiseTheUninterruptedOne) {
+  std::string yaml = contact_scene("ckpt_rigid");
+  const std::string block = "initial_velocity: [5, 0, -5]}";
+  yaml.replace(yaml.find(block), block.size(), "initial_velocity: [5, 0, -5], rigid: free, angular_velocity: [0, 300, 100]}");
+  long contacts = 0;
+  expect_bitwise_continuation("ckpt_rigid", yaml, 60, 80, &contacts);
+  EXPECT_GT(contacts, 0) << "the scene must be in contact after the checkpoint";
+}
+
 // The step controller's state (StepControl: the step held, its window) is part
 // of the checkpoint, so a restarted run changes its step where the uninterrupted
 // one does.

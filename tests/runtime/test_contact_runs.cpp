@@ -283,9 +283,7 @@ TEST(ContactRuns, ObliqueFrictionalImpactConservesMomenta) {
     Model m = build_model(scene_from_text("oblique", oblique_scene(c.law)));
     Simulation sim(m, {});
     const Ledger l0 = sim.ledger();
-    double L_scale = 0;
-    for (Index i = 0; i < m.mesh.num_nodes(); ++i)
-      L_scale += m.mass[i] * sim.positions()[i].norm() * sim.velocities()[i].norm();
+    const double L_scale = test::angular_momentum_scale(sim);
     long contact_steps = 0;
     double dp = 0, dL = 0, dE = 0;
     int penetrations = 0;
