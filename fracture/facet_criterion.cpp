@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -17,19 +18,18 @@ namespace {
 
 /// Facets per call of facet_traction_lanes: one AVX-512 vector, two AVX ones.
 constexpr int kFacetLanes = 8;
+/// Facets screened at a time before their tractions are evaluated.
+constexpr Index kFacetChunk = 1024;
 
-/// Element e's Cauchy stress from `stress` (6 Voigt or 9 row-major values
-/// per element, as element_cauchy_stress) into lane l, row-major.
-template <int N>
-[[gnu::always_inline]] inline void gather_stress(const double* stress, int stress_size, Index e, double (&out)[9][N],
-                                                 int l) {
-  const double* s = stress + static_cast<size_t>(e) * stress_size;
-  if (stress_size == 6) {
-    constexpr int kVoigt[9] = {0, 5, 4, 5, 1, 3, 4, 3, 2};
-    for (int q = 0; q < 9; ++q) out[q][l] = s[kVoigt[q]];
-  } else {
-    for (int q = 0; q < 9; ++q) out[q][l] = s[q];
+/// Lane `to` := lane `from`.
+template <int N, int S>
+void copy_lane(FacetTractionLanes<N, S>& L, int from, int to) {
+  for (int q = 0; q < 9; ++q) L.x[q][to] = L.x[q][from];
+  for (int q = 0; q < S; ++q) {
+    L.stress[0][q][to] = L.stress[0][q][from];
+    L.stress[1][q][to] = L.stress[1][q][from];
   }
+  L.beta[to] = L.beta[from];
 }
 
 /// The law of the material of element e0 of an interior facet (e0, e1) when
@@ -39,17 +39,6 @@ const CohesiveLaw* material_law(const Mesh& mesh, const FractureLaws& laws, Inde
   const std::optional<CohesiveLaw>& l0 = laws.material[mesh.elem_material[e0]];
   const std::optional<CohesiveLaw>& l1 = laws.material[mesh.elem_material[e1]];
   return l0 && l1 ? &*l0 : nullptr;
-}
-
-/// Lane `to` := lane `from`.
-template <int N>
-void copy_lane(FacetTractionLanes<N>& L, int from, int to) {
-  for (int q = 0; q < 9; ++q) {
-    L.x[q][to] = L.x[q][from];
-    L.stress[0][q][to] = L.stress[0][q][from];
-    L.stress[1][q][to] = L.stress[1][q][from];
-  }
-  L.beta[to] = L.beta[from];
 }
 
 }  // namespace
@@ -63,11 +52,10 @@ std::optional<CohesiveLaw> facet_law(const Mesh& mesh, const Topology& topo, Fra
 }
 
 Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Index e) {
-  double s[9][1];
-  gather_stress(stress.data(), stress_size, e, s, 0);
+  const double* s = stress.data() + static_cast<size_t>(e) * stress_size;
   Mat3 sigma;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) sigma(i, j) = s[3 * i + j][0];
+    for (int j = 0; j < 3; ++j) sigma(i, j) = s[stress_size == 6 ? kVoigtOfRowMajor[3 * i + j] : 3 * i + j];
   return sigma;
 }
 
@@ -93,16 +81,19 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   // the mean of its two elements', so a facet can break only if
   // (|sigma_0|_F + |sigma_1|_F) / 2 x max(1, 1/beta) >= sigma_c, hence only
   // if one of its elements is "hot": |sigma_e|_F max(1, 1/beta) >= sigma_c.
-  // Pass 1 computes the norms (one contiguous, vectorisable sweep); pass 2
-  // visits the facets of hot elements only. The factor 1 + 1e-12 keeps the
-  // bound safe against the round-off of the norms. Both passes cover the
-  // local elements (all on one rank).
+  // Pass 1 computes the norms (one contiguous, vectorisable sweep) and stops
+  // the check when no element is hot (a cold field); pass 2 screens the
+  // facets with the bound. The factor 1 + 1e-12 keeps the bound safe against
+  // the round-off of the norms. Pass 1 covers the local elements (all on one
+  // rank), pass 2 the facets whose smaller element is owned.
   constexpr double kSafe = 1.0 + 1e-12;
   const bool all = local.empty();
   const Index nlocal = all ? ne : static_cast<Index>(local.size());
   auto elem = [&](Index k) { return all ? k : local[k]; };
-  std::unique_ptr<double[]> frobenius(new double[ne]);  // set for the local elements
+  std::unique_ptr<double[]> frobenius(new double[ne]());  // set for the local elements, else 0
   const double* s = stress.data();
+  const double hot = weakest / widest;
+  std::atomic<bool> any_hot = false;
   tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 4096), [&](const tbb::blocked_range<Index>& r) {
     if (stress_size == 6) {
       for (Index k = r.begin(); k != r.end(); ++k) {
@@ -118,72 +109,80 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         frobenius[elem(k)] = kSafe * std::sqrt(sum);
       }
     }
+    bool hot_here = false;
+    for (Index k = r.begin(); k != r.end(); ++k) hot_here |= frobenius[elem(k)] >= hot;
+    if (hot_here) any_hot = true;
   });
-  const double hot = weakest / widest;
-  // Per material: max(1, 1/beta) of its law (no law: never read).
-  std::vector<double> wide(laws.material.size(), 1.0);
-  for (size_t m = 0; m < wide.size(); ++m)
-    if (laws.material[m]) wide[m] = std::max(1.0, 1.0 / laws.material[m]->beta);
+  if (!any_hot) return {};
   std::unique_ptr<char[]> owned_flag;  // on ranks: 1 for the owned elements
   if (!owned.empty()) {
     owned_flag.reset(new char[ne]());
     for (Index e : owned) owned_flag[e] = 1;
   }
-  auto is_owned = [&](Index e) { return !owned_flag || owned_flag[e]; };
-  const int* mat = mesh.elem_material.data();
-  const Vec3* xs = x.data();
-  // Each facet is evaluated once, from the hot adjacent element of smaller
-  // local id; the facets that pass the cheap tests are gathered kFacetLanes
-  // at a time and their tractions computed side by side
-  // (facet_traction_lanes: each lane the bits of a lone facet's). Facets
-  // found by any thread are gathered and sorted by global id, so the result
-  // does not depend on the threads.
+  // Pass 2, over the facets: keep those whose bound reaches the strength
+  // (with the largest max(1, 1/beta) and, without scatter, the smallest
+  // sigma_c: still a safe bound, read without the materials), written
+  // without branches; then evaluate them kFacetLanes at a time.
   tbb::enumerable_thread_specific<std::vector<Index>> found;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 1024), [&](const tbb::blocked_range<Index>& r) {
+  const Index nf = topo.num_facets();
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, kFacetChunk), [&](const tbb::blocked_range<Index>& r) {
     std::vector<Index>* local_found = nullptr;
-    FacetTractionLanes<kFacetLanes> L;
-    Index lane_facet[kFacetLanes];
-    double lane_strength[kFacetLanes];
-    int lanes = 0;
-    auto evaluate = [&] {
-      for (int l = lanes; l < kFacetLanes; ++l) copy_lane(L, 0, l);  // padding, not read back
-      facet_traction_lanes(L);
-      for (int l = 0; l < lanes; ++l)
-        if (L.traction[l] >= lane_strength[l]) {
-          if (!local_found) local_found = &found.local();
-          local_found->push_back(lane_facet[l]);
-        }
-      lanes = 0;
-    };
-    for (Index k = r.begin(); k != r.end(); ++k) {
-      const Index e = elem(k);
-      if (frobenius[e] < hot) continue;
-      for (int i = 0; i < 4; ++i) {
-        const Index f = topo.elem_facet[4 * static_cast<size_t>(e) + i];
-        if (topo.facet_state[f] != FacetState::intact) continue;  // boundary, cohesive or free
+    Index candidate[kFacetChunk];
+    for (Index f0 = r.begin(); f0 < r.end(); f0 += kFacetChunk) {
+      const Index f1 = std::min<Index>(f0 + kFacetChunk, r.end());
+      int count = 0;
+      for (Index f = f0; f < f1; ++f) {
         const auto [e0, e1] = topo.facet_elem[f];
-        const Index other = e0 == e ? e1 : e0;
-        // The owner of the smaller element checks the facet (then both are local).
-        if (!is_owned(std::min(e, other))) continue;
-        if (other < e && frobenius[other] >= hot) continue;  // evaluated from `other`
-        // facet_law's sigma_c and beta, without building the law.
-        const CohesiveLaw* law = material_law(mesh, laws, e0, e1);
-        if (!law) continue;
-        const double sigma_c = laws.facet_strength.empty() ? law->sigma_c : laws.facet_strength[f];
-        if (0.5 * (frobenius[e0] + frobenius[e1]) * wide[mat[e0]] < sigma_c) continue;
-        const Index* corner = mesh.element(e0);
-        const std::array<int, 6>& face = kTetFaces[topo.facet_face[f][0]];
-        for (int a = 0; a < 3; ++a)
-          for (int c = 0; c < 3; ++c) L.x[3 * a + c][lanes] = xs[corner[face[a]]][c];
-        gather_stress(stress.data(), stress_size, e0, L.stress[0], lanes);
-        gather_stress(stress.data(), stress_size, e1, L.stress[1], lanes);
-        L.beta[lanes] = law->beta;
-        lane_facet[lanes] = f;
-        lane_strength[lanes] = sigma_c;
-        if (++lanes == kFacetLanes) evaluate();
+        const Index e1_or_e0 = e1 < 0 ? e0 : e1;  // intact facets have two elements
+        const double strength = laws.facet_strength.empty() ? weakest : laws.facet_strength[f];
+        const bool keep = (topo.facet_state[f] == FacetState::intact) &
+                          (!owned_flag || owned_flag[std::min(e0, e1_or_e0)]) &
+                          (0.5 * (frobenius[e0] + frobenius[e1_or_e0]) * widest >= strength);
+        candidate[count] = f;
+        count += keep;
       }
+      auto evaluate = [&]<int S>(std::span<const Index> facets) {
+        FacetTractionLanes<kFacetLanes, S> L;
+        Index lane_facet[kFacetLanes];
+        double lane_strength[kFacetLanes];
+        int lanes = 0;
+        auto run = [&] {
+          for (int l = lanes; l < kFacetLanes; ++l) copy_lane(L, 0, l);  // padding, not read back
+          facet_traction_lanes(L);
+          for (int l = 0; l < lanes; ++l)
+            if (L.traction[l] >= lane_strength[l]) {
+              if (!local_found) local_found = &found.local();
+              local_found->push_back(lane_facet[l]);
+            }
+          lanes = 0;
+        };
+        for (const Index f : facets) {
+          const auto [e0, e1] = topo.facet_elem[f];
+          const CohesiveLaw* law = material_law(mesh, laws, e0, e1);  // facet_law's, not built
+          if (!law) continue;
+          const Index* corner = mesh.element(e0);
+          const std::array<int, 6>& face = kTetFaces[topo.facet_face[f][0]];
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c) L.x[3 * a + c][lanes] = x[corner[face[a]]][c];
+          const double* s0 = stress.data() + static_cast<size_t>(e0) * S;
+          const double* s1 = stress.data() + static_cast<size_t>(e1) * S;
+          for (int q = 0; q < S; ++q) {
+            L.stress[0][q][lanes] = s0[q];
+            L.stress[1][q][lanes] = s1[q];
+          }
+          L.beta[lanes] = law->beta;
+          lane_facet[lanes] = f;
+          lane_strength[lanes] = laws.facet_strength.empty() ? law->sigma_c : laws.facet_strength[f];
+          if (++lanes == kFacetLanes) run();
+        }
+        if (lanes > 0) run();
+      };
+      const std::span<const Index> kept(candidate, count);
+      if (stress_size == 6)
+        evaluate.template operator()<6>(kept);
+      else
+        evaluate.template operator()<9>(kept);
     }
-    if (lanes > 0) evaluate();
   });
   std::vector<std::pair<GlobalId, Index>> keyed;
   for (const std::vector<Index>& v : found)

@@ -56,12 +56,18 @@ inline double facet_effective_traction(const Mat3& sigma, const Vec3& n, double 
   return effective_traction_lane(s, u, beta, 0);
 }
 
+/// Row-major index q = 3i + j of a symmetric stress -> its Voigt component
+/// (xx, yy, zz, yz, xz, xy).
+inline constexpr int kVoigtOfRowMajor[9] = {0, 5, 4, 5, 1, 3, 4, 3, 2};
+
 /// N facets side by side (lane l = one facet), struct-of-arrays, for
-/// facet_traction_lanes.
-template <int N>
+/// facet_traction_lanes. S = 6: stresses in Voigt order (xx, yy, zz, yz, xz,
+/// xy); S = 9: row-major, stress[k][3i + j][l] = sigma(i, j).
+template <int N, int S>
 struct FacetTractionLanes {
+  static_assert(S == 6 || S == 9);
   double x[9][N];          ///< in: corners a, b, c of the facet, x[3a + i][l], m
-  double stress[2][9][N];  ///< in: Cauchy stresses of its two elements, row-major, stress[k][3i + j][l], Pa
+  double stress[2][S][N];  ///< in: Cauchy stresses of its two elements, Pa
   double beta[N];          ///< in: shear-to-normal weighting of its law
   double traction[N];      ///< out: effective traction t_eff, Pa
 };
@@ -74,8 +80,8 @@ struct FacetTractionLanes {
 /// order, so the compiler vectorises across facets and every lane has the
 /// bits of the one-facet Eigen evaluation (any N, any lane: ranks x threads
 /// determinism). ~70 flops, a square root and 4 divisions per facet.
-template <int N>
-inline void facet_traction_lanes(FacetTractionLanes<N>& L) {
+template <int N, int S>
+inline void facet_traction_lanes(FacetTractionLanes<N, S>& L) {
   double n[3][N], sigma[9][N];
   for (int l = 0; l < N; ++l) {
     double u[3], v[3];
@@ -91,7 +97,9 @@ inline void facet_traction_lanes(FacetTractionLanes<N>& L) {
     n[0][l] = c0 / r;
     n[1][l] = c1 / r;
     n[2][l] = c2 / r;
-    for (int q = 0; q < 9; ++q) sigma[q][l] = 0.5 * (L.stress[0][q][l] + L.stress[1][q][l]);
+    double mean[S];
+    for (int q = 0; q < S; ++q) mean[q] = 0.5 * (L.stress[0][q][l] + L.stress[1][q][l]);
+    for (int q = 0; q < 9; ++q) sigma[q][l] = mean[S == 6 ? kVoigtOfRowMajor[q] : q];
   }
   for (int l = 0; l < N; ++l) L.traction[l] = effective_traction_lane(sigma, n, L.beta[l], l);
 }
