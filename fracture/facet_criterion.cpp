@@ -96,6 +96,7 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   std::unique_ptr<double[]> frobenius(new double[ne]());  // set for the local elements, else 0
   const double* s = stress.data();
   const double hot = weakest / widest;
+  const int* mat = mesh.elem_material.data();
   std::atomic<bool> any_hot = false;
   tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 4096), [&](const tbb::blocked_range<Index>& r) {
     if (stress_size == 6) {
@@ -112,8 +113,15 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         frobenius[elem(k)] = kSafe * std::sqrt(sum);
       }
     }
+    // facet_law's rule: a facet has a law only when both its materials
+    // fracture. An element of a material that does not gets -inf: the bound
+    // of its facets is -inf, so pass 2 drops them without the materials.
     bool hot_here = false;
-    for (Index k = r.begin(); k != r.end(); ++k) hot_here |= frobenius[elem(k)] >= hot;
+    for (Index k = r.begin(); k != r.end(); ++k) {
+      const Index e = elem(k);
+      if (!laws.material[mat[e]]) frobenius[e] = -HUGE_VAL;
+      hot_here |= frobenius[e] >= hot;
+    }
     if (hot_here) any_hot = true;
   });
   if (!any_hot) return {};
@@ -122,14 +130,11 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
     owned_flag.reset(new char[ne]());
     for (Index e : owned) owned_flag[e] = 1;
   }
-  // facet_law's rule: a facet has a law when both its materials fracture.
-  std::vector<char> fractures(laws.material.size());
-  for (size_t m = 0; m < fractures.size(); ++m) fractures[m] = laws.material[m].has_value();
-  const int* mat = mesh.elem_material.data();
   // Pass 2, over the facets: keep those whose bound reaches the strength
   // (with the largest max(1, 1/beta) and, without scatter, the smallest
   // sigma_c: still a safe bound, read without the materials), written
-  // without branches; then evaluate them kFacetLanes at a time.
+  // without branches; then evaluate them kFacetLanes at a time (the law of
+  // element 0's material, facet_law's).
   tbb::enumerable_thread_specific<std::vector<Index>> found;
   const Index nf = topo.num_facets();
   tbb::parallel_for(tbb::blocked_range<Index>(0, nf, kFacetChunk), [&](const tbb::blocked_range<Index>& r) {
@@ -144,7 +149,6 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         const double strength = laws.facet_strength.empty() ? weakest : laws.facet_strength[f];
         const bool keep = (topo.facet_state[f] == FacetState::intact) &
                           (!owned_flag || owned_flag[std::min(e0, e1_or_e0)]) &
-                          fractures[mat[e0]] & fractures[mat[e1_or_e0]] &
                           (0.5 * (frobenius[e0] + frobenius[e1_or_e0]) * widest >= strength);
         candidate[count] = f;
         count += keep;
