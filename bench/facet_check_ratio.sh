@@ -27,7 +27,8 @@ for r in $(seq 1 "$runs"); do
     load0=$(cut -d' ' -f1 /proc/loadavg)
     "$build/bench/bench_fracture" --benchmark_filter='threads:1/' --benchmark_repetitions="$reps" \
       --benchmark_enable_random_interleaving=true \
-      --benchmark_out="$tmp/run.json" --benchmark_out_format=json > /dev/null
+      --benchmark_out="$tmp/run.json" --benchmark_out_format=json > /dev/null 2> "$tmp/stderr" ||
+      { cat "$tmp/stderr" >&2; exit 1; }
     load1=$(cut -d' ' -f1 /proc/loadavg)
     /usr/bin/python3 - "$tmp/run.json" "$build" "$r" "$load0" "$load1" >> "$out" <<'PY'
 import json, sys
