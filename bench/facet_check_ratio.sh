@@ -19,18 +19,11 @@ set -euo pipefail
 runs=${RUNS:-3}
 reps=${REPS:-5}
 out=${OUT:-$(cd "$(dirname "$0")" && pwd)/results/facet_check_ratio.csv}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "$0")/interleaved.sh"
 echo "build,run,load1_before,load1_after,benchmark,field,cpu_ms,elements,facets,critical_facets" > "$out"
-for r in $(seq 1 "$runs"); do
-  for build in "$@"; do
-    load0=$(cut -d' ' -f1 /proc/loadavg)
-    "$build/bench/bench_fracture" --benchmark_filter='threads:1/' --benchmark_repetitions="$reps" \
-      --benchmark_enable_random_interleaving=true \
-      --benchmark_out="$tmp/run.json" --benchmark_out_format=json > /dev/null 2> "$tmp/stderr" ||
-      { cat "$tmp/stderr" >&2; exit 1; }
-    load1=$(cut -d' ' -f1 /proc/loadavg)
-    /usr/bin/python3 - "$tmp/run.json" "$build" "$r" "$load0" "$load1" >> "$out" <<'PY'
+BENCH_FLAGS=(--benchmark_filter='threads:1/' --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true)
+on_run() {
+  /usr/bin/python3 - "$5" "$1" "$2" "$3" "$4" >> "$out" <<'PY'
 import json, sys
 src, build, run, l0, l1 = sys.argv[1:6]
 for x in json.load(open(src))["benchmarks"]:
@@ -44,8 +37,8 @@ for x in json.load(open(src))["benchmarks"]:
     print(f'{build},{run},{l0},{l1},{name},{field},{x["cpu_time"]:.4f},{round(elements)},'
           f'{int(x.get("facets", 0))},{int(x.get("critical_facets", 0))}')
 PY
-  done
-done
+}
+interleaved "$runs" bench_fracture "$@"
 /usr/bin/python3 - "$out" <<'PY'
 import csv, statistics, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
