@@ -25,10 +25,8 @@ BENCH_FLAGS=(--benchmark_filter='threads:1/' --benchmark_repetitions="$reps" --b
 on_run() {
   /usr/bin/python3 - "$5" "$1" "$2" "$3" "$4" >> "$out" <<'PY'
 import json, sys
-src, build, run, l0, l1 = sys.argv[1:6]
-for x in json.load(open(src))["benchmarks"]:
-    if x.get("run_type") != "iteration":
-        continue
+build, run, l0, l1 = sys.argv[2:6]
+for x in (x for x in json.load(open(sys.argv[1]))["benchmarks"] if x.get("run_type") == "iteration"):
     name = x["run_name"].split("/")[0]
     field = x["run_name"].split("cold_mixed_hot:")[1].split("/")[0] if "cold_mixed_hot" in x["run_name"] else ""
     field = {"0": "cold", "1": "mixed", "2": "hot"}.get(field, "")
