@@ -93,10 +93,13 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   const bool all = local.empty();
   const Index nlocal = all ? ne : static_cast<Index>(local.size());
   auto elem = [&](Index k) { return all ? k : local[k]; };
-  std::unique_ptr<double[]> frobenius(new double[ne]());  // set for the local elements, else 0
+  // Set for the local elements; on ranks 0 for the others (pass 2 reads them, never to keep a facet).
+  std::unique_ptr<double[]> frobenius(all ? new double[ne] : new double[ne]());
   const double* s = stress.data();
   const double hot = weakest / widest;
   const int* mat = mesh.elem_material.data();
+  const bool every_material_fractures =
+      std::all_of(laws.material.begin(), laws.material.end(), [](const auto& law) { return law.has_value(); });
   std::atomic<bool> any_hot = false;
   tbb::parallel_for(tbb::blocked_range<Index>(0, nlocal, 4096), [&](const tbb::blocked_range<Index>& r) {
     if (stress_size == 6) {
@@ -119,7 +122,7 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
     bool hot_here = false;
     for (Index k = r.begin(); k != r.end(); ++k) {
       const Index e = elem(k);
-      if (!laws.material[mat[e]]) frobenius[e] = -HUGE_VAL;
+      if (!every_material_fractures && !laws.material[mat[e]]) frobenius[e] = -HUGE_VAL;
       hot_here |= frobenius[e] >= hot;
     }
     if (hot_here) any_hot = true;
