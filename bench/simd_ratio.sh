@@ -18,16 +18,11 @@ set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: RUNS=3 OUT=file.csv simd_ratio.sh BUILD_A BUILD_B [BUILD...]" >&2; exit 2; }
 runs=${RUNS:-3}
 out=${OUT:-$(cd "$(dirname "$0")" && pwd)/results/simd_ratio.csv}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "$0")/interleaved.sh"
 echo "build,run,order,load1_before,load1_after,ms_per_step,cpu_ms_per_step,M_element_steps_per_s,M_element_steps_per_cpu_s,element_loop_ms" > "$out"
-for r in $(seq 1 "$runs"); do
-  for build in "$@"; do
-    load0=$(cut -d' ' -f1 /proc/loadavg)
-    "$build/bench/bench_step" --benchmark_filter='threads:1/' --benchmark_repetitions=3 \
-      --benchmark_out="$tmp/run.json" --benchmark_out_format=json > /dev/null
-    load1=$(cut -d' ' -f1 /proc/loadavg)
-    /usr/bin/python3 - "$tmp/run.json" "$build" "$r" "$load0" "$load1" >> "$out" <<'PY'
+BENCH_FLAGS=(--benchmark_filter='threads:1/' --benchmark_repetitions=3)
+on_run() {
+  /usr/bin/python3 - "$5" "$1" "$2" "$3" "$4" >> "$out" <<'PY'
 import json, sys
 src, build, run, l0, l1 = sys.argv[1:6]
 for x in json.load(open(src))["benchmarks"]:
@@ -38,8 +33,8 @@ for x in json.load(open(src))["benchmarks"]:
     print(f'{build},{run},{order},{l0},{l1},{x["real_time"]:.3f},{x["cpu_time"]:.3f},'
           f'{x["items_per_second"] / 1e6:.3f},{per_cpu:.3f},{1e3 * x["element_loop_s_per_step"]:.3f}')
 PY
-  done
-done
+}
+interleaved "$runs" bench_step "$@"
 /usr/bin/python3 - "$out" "$@" <<'PY'
 import csv, statistics, sys
 path, builds = sys.argv[1], sys.argv[2:]

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kernels/cohesive.hpp"
+#include "kernels/facet_traction.hpp"
 #include "mesh/topology.hpp"
 
 namespace shatter {

@@ -169,17 +169,4 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   return out;
 }
 
-/// Effective traction of the extrinsic insertion criterion (Camacho & Ortiz,
-/// IJSS 33 (1996) 2899; Pandolfi & Ortiz, Eng. Comput. 18 (2002) 148):
-/// t_eff = sqrt(<tn>^2 + tau^2 / beta^2) for the traction t = sigma n on a
-/// facet of unit normal n, sigma the Cauchy stress (Pa). Compressive tn does
-/// not open the facet. Returns Pa; the facet breaks when t_eff >= sigma_c.
-inline double facet_effective_traction(const Mat3& sigma, const Vec3& n, double beta) {
-  const Vec3 t = sigma * n;
-  const double tn = t.dot(n);
-  const double tau2 = (t - tn * n).squaredNorm();
-  const double tn_pos = std::max(tn, 0.0);
-  return std::sqrt(tn_pos * tn_pos + tau2 / (beta * beta));
-}
-
 }  // namespace shatter

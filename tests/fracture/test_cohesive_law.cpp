@@ -8,6 +8,7 @@
 
 #include "expect_close.hpp"
 #include "kernels/cohesive.hpp"
+#include "kernels/facet_traction.hpp"
 
 using namespace shatter;
 

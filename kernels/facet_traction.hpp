@@ -1,0 +1,107 @@
+#pragma once
+// Effective traction of the extrinsic insertion criterion on facets, one
+// facet or N side by side (vectorised across facets, as the element lane
+// kernels of kernels/tet4.hpp).
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+/// a b + c as Eigen 3.4 evaluates the first two rows of a fixed-size
+/// Matrix3d * Vector3d (one 2-double packet, pmadd: fused where the SIMD
+/// width has FMA, -ffp-contract=off or not). Lets the lane kernel keep the
+/// bits of the Eigen form sigma * n (tests/kernels/test_facet_traction.cpp).
+[[gnu::always_inline]] inline double packet_madd(double a, double b, double c) {
+#ifdef EIGEN_VECTORIZE_FMA
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
+/// Lane l: the effective traction of the criterion of Camacho & Ortiz (IJSS
+/// 33 (1996) 2899; Pandolfi & Ortiz, Eng. Comput. 18 (2002) 148),
+///   t_eff = sqrt(<tn>^2 + tau^2 / beta^2),  t = sigma n,  tn = t . n,
+///   tau = |t - tn n|,
+/// for the Cauchy stress sigma (row-major, sigma[3i + j][l] = sigma(i, j),
+/// Pa) and the unit normal n (n[i][l]); compressive tn does not open the
+/// facet. Returns Pa. The operations are those of the Eigen expressions
+/// t = sigma * n, t.dot(n), (t - tn n).squaredNorm() (same order and
+/// rounding), so every lane has their bits.
+template <int N>
+[[gnu::always_inline]] inline double effective_traction_lane(const double (&sigma)[9][N], const double (&n)[3][N],
+                                                             double beta, int l) {
+  const double n0 = n[0][l], n1 = n[1][l], n2 = n[2][l];
+  const double t0 = packet_madd(sigma[2][l], n2, packet_madd(sigma[1][l], n1, sigma[0][l] * n0));
+  const double t1 = packet_madd(sigma[5][l], n2, packet_madd(sigma[4][l], n1, sigma[3][l] * n0));
+  const double t2 = sigma[6][l] * n0 + (sigma[7][l] * n1 + sigma[8][l] * n2);
+  const double tn = t0 * n0 + t1 * n1 + t2 * n2;
+  const double s0 = t0 - tn * n0, s1 = t1 - tn * n1, s2 = t2 - tn * n2;
+  const double tau2 = s0 * s0 + s1 * s1 + s2 * s2;
+  const double tn_pos = std::max(tn, 0.0);
+  return std::sqrt(tn_pos * tn_pos + tau2 / (beta * beta));
+}
+
+/// Effective traction t_eff of the criterion (effective_traction_lane) for
+/// the Cauchy stress sigma (Pa) on a facet of unit normal n. Returns Pa; the
+/// facet breaks when t_eff >= sigma_c.
+inline double facet_effective_traction(const Mat3& sigma, const Vec3& n, double beta) {
+  double s[9][1], u[3][1];
+  for (int i = 0; i < 3; ++i) {
+    u[i][0] = n[i];
+    for (int j = 0; j < 3; ++j) s[3 * i + j][0] = sigma(i, j);
+  }
+  return effective_traction_lane(s, u, beta, 0);
+}
+
+/// Row-major index q = 3i + j of a symmetric stress -> its Voigt component
+/// (xx, yy, zz, yz, xz, xy).
+inline constexpr int kVoigtOfRowMajor[9] = {0, 5, 4, 5, 1, 3, 4, 3, 2};
+
+/// N facets side by side (lane l = one facet), struct-of-arrays, for
+/// facet_traction_lanes. S = 6: stresses in Voigt order (xx, yy, zz, yz, xz,
+/// xy); S = 9: row-major, stress[k][3i + j][l] = sigma(i, j).
+template <int N, int S>
+struct FacetTractionLanes {
+  static_assert(S == 6 || S == 9);
+  double x[9][N];          ///< in: corners a, b, c of the facet, x[3a + i][l], m
+  double stress[2][S][N];  ///< in: Cauchy stresses of its two elements, Pa
+  double beta[N];          ///< in: shear-to-normal weighting of its law
+  double traction[N];      ///< out: effective traction t_eff, Pa
+};
+
+/// Effective traction of N facets: n the unit normal (b - a) x (c - a) /
+/// |(b - a) x (c - a)| of the corner triangle (0 if degenerate), sigma the
+/// mean of the two elements' stresses, then effective_traction_lane. The
+/// operations are those of the Eigen forms (b - a).cross(c - a).normalized()
+/// and 0.5 * (sigma_0 + sigma_1) in scalar IEEE arithmetic with a fixed
+/// order, so the compiler vectorises across facets and every lane has the
+/// bits of the one-facet Eigen evaluation (any N, any lane: ranks x threads
+/// determinism). ~70 flops, a square root and 4 divisions per facet.
+template <int N, int S>
+inline void facet_traction_lanes(FacetTractionLanes<N, S>& L) {
+  double n[3][N], sigma[9][N];
+  for (int l = 0; l < N; ++l) {
+    double u[3], v[3];
+    for (int i = 0; i < 3; ++i) {
+      u[i] = L.x[3 + i][l] - L.x[i][l];
+      v[i] = L.x[6 + i][l] - L.x[i][l];
+    }
+    const double c0 = u[1] * v[2] - u[2] * v[1];
+    const double c1 = u[2] * v[0] - u[0] * v[2];
+    const double c2 = u[0] * v[1] - u[1] * v[0];
+    const double z = c0 * c0 + c1 * c1 + c2 * c2;
+    const double r = z > 0 ? std::sqrt(z) : 1.0;  // Eigen: a zero vector stays zero
+    n[0][l] = c0 / r;
+    n[1][l] = c1 / r;
+    n[2][l] = c2 / r;
+    double mean[S];
+    for (int q = 0; q < S; ++q) mean[q] = 0.5 * (L.stress[0][q][l] + L.stress[1][q][l]);
+    for (int q = 0; q < 9; ++q) sigma[q][l] = mean[S == 6 ? kVoigtOfRowMajor[q] : q];
+  }
+  for (int l = 0; l < N; ++l) L.traction[l] = effective_traction_lane(sigma, n, L.beta[l], l);
+}
+
+}  // namespace shatter
