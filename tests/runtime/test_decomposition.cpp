@@ -23,15 +23,26 @@
 namespace shatter {
 namespace {
 
+int world_rank() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+int world_size() {
+  int ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  return ranks;
+}
+/// The scene `yaml`, written by each rank to a file of its own (one file
+/// written by all would race).
+Scene rank_scene(const std::string& name, const std::string& yaml) {
+  return test::scene_from_text(name + "_rank" + std::to_string(world_rank()), yaml);
+}
+
 const Model& box() {
-  static const Model m = [] {
-    int rank = 0;
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    return build_model(test::scene_from_text(
-        "decomposition_box_rank" + std::to_string(rank),
-        test::steel_body_scene("decomposition_box",
-                               "shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1")));
-  }();
+  static const Model m = build_model(rank_scene(
+      "decomposition_box", test::steel_body_scene("decomposition_box",
+                                                  "shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1")));
   return m;
 }
 
@@ -200,12 +211,9 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   // Rank 0 meshes and cuts the model; every rank gets its part (owned
   // elements and ghost layer), which holds the whole model's values and, in
   // the element loop, gives the whole model's forces bit for bit.
-  // (Each rank writes its own scene file: one file written by all would race.)
-  int rank = 0, ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  const Scene scene = test::scene_from_text(
-      "build_model_world_rank" + std::to_string(rank),
+  const int ranks = world_size();
+  const Scene scene = rank_scene(
+      "build_model_world",
       test::steel_body_scene("world", "shape: sphere, radius: 0.01, element_size: 0.0015, order: 2",
                              "    initial_velocity: [1, 0, 0]\n"
                              "    angular_velocity: [0, 0, 300]\n"));
@@ -266,11 +274,9 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
   // first-layer elements has its whole star, splits as in the whole model,
   // and takes the whole model's index; the ranks touching it come from the
   // part's stars. Two rounds of insertion, the second splitting copies.
-  int rank = 0, ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  const Scene scene = test::scene_from_text(
-      "fracture_parts_rank" + std::to_string(rank),
+  const int ranks = world_size();
+  const Scene scene = rank_scene(
+      "fracture_parts",
       "name: fracture_parts\ntime: {end: 1.0}\nmaterials:\n"
       "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3,\n"
       "          fracture: {strength: 3.0e8, energy: 100.0, beta: 1.0}}\n"
