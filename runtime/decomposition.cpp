@@ -50,9 +50,11 @@ void check_ranks(const Model& model, int ranks) {
                      std::to_string(ng) + ")");
 }
 
-NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank) {
+NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank,
+                                 std::span<const Index> whole_element) {
   std::vector<int> elem_part(mesh.num_elements());
-  for (Index e = 0; e < mesh.num_elements(); ++e) elem_part[e] = granule_rank[e / ElementForces::kGranule];
+  for (Index e = 0; e < mesh.num_elements(); ++e)
+    elem_part[e] = granule_rank[(whole_element.empty() ? e : whole_element[e]) / ElementForces::kGranule];
   return touching_ranks(mesh, elem_part);
 }
 
@@ -107,9 +109,7 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     // From the stars: with two layers, every node of a held element is whole
     // here, so its ranks are right (after splits too); the outer layer's own
     // nodes get only some of theirs, and are never read.
-    std::vector<int> elem_part(ne);
-    for (Index e = 0; e < ne; ++e) elem_part[e] = granule_rank_[model_.whole_element(e) / ElementForces::kGranule];
-    NodeRanks touch = touching_ranks(mesh, elem_part);
+    NodeRanks touch = granule_touching_ranks(mesh, granule_rank_, model_.part.element_index);
     node_rank_offsets_ = std::move(touch.offsets);
     node_ranks_ = std::move(touch.ranks);
   }
@@ -310,6 +310,10 @@ double Decomposition::min(double value) const {
 
 void Decomposition::min(std::span<double> values) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MIN, comm_);
+}
+
+void Decomposition::max(std::span<double> values) const {
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX, comm_);
 }
 
 int Decomposition::rank_of_min(double value) const {

@@ -153,6 +153,8 @@ class Decomposition {
   double min(double value) const;
   /// In place: the element-wise global minima.
   void min(std::span<double> values) const;
+  /// In place: the element-wise global maxima.
+  void max(std::span<double> values) const;
   /// The smallest rank holding the global minimum of `value`.
   int rank_of_min(double value) const;
   /// Element-wise sums over the ranks, on every rank.
@@ -184,9 +186,12 @@ class Decomposition {
 /// many ranks it can take.
 void check_ranks(const Model& model, int ranks);
 
-/// The ranks touching each node of the whole mesh `mesh` when granule g
-/// (ElementForces::kGranule elements) belongs to granule_rank[g].
-NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank);
+/// The ranks touching each node of `mesh` when granule g of the whole model
+/// (ElementForces::kGranule elements) belongs to granule_rank[g]; on a part,
+/// `whole_element` gives each element's index in the whole model (empty: `mesh`
+/// is the whole model). A node's ranks are whole when its star is.
+NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank,
+                                 std::span<const Index> whole_element = {});
 
 template <class Body>
 void Decomposition::for_touched(Index num_nodes, Body body) const {
