@@ -108,9 +108,11 @@ long Simulation::run() {
   fields_.reset();
   if (!opt_.out_dir.empty()) {
     FractureSummary fracture;
-    if (fracture_)
-      fracture = {write_fragments(), fracture_->across_ranks(), -dec_->min(-fracture_->check_cpu_seconds()),
-                  -dec_->min(-insert_cpu_seconds_)};
+    if (fracture_) {
+      double cpu[2] = {fracture_->check_cpu_seconds(), insert_cpu_seconds_};
+      dec_->max(cpu);
+      fracture = {write_fragments(), fracture_->across_ranks(), cpu[0], cpu[1]};
+    }
     const DecompositionStats stats = dec_->stats();
     const ContactBalance pairs = contact_ ? contact_->balance() : ContactBalance{};
     const std::pair<std::vector<long>, long> memory{dec_->gather(peak_memory_bytes()), dec_->max(loop_bytes())};
