@@ -69,11 +69,10 @@ std::vector<std::vector<Index>> held_elements(const Mesh& wm, const NodeRanks& t
   });
   if (two_layers) {
     // Those holding an element of each node's star, then each element's.
-    std::vector<std::vector<int>> at(nn);
-    for (Index e = 0; e < ne; ++e)
-      for (int a = 0; a < k; ++a)
-        for (int q : layer.of(e)) at[wm.element(e)[a]].push_back(q);
-    const NodeRanks star = gather(nn, [&](Index n, std::vector<int>& rs) { rs.swap(at[n]); });
+    const NodeRanks star = gather(nn, [&](Index n, std::vector<int>& rs) {
+      for (Index e : node_star(wm, n))
+        for (int q : layer.of(e)) rs.push_back(q);
+    });
     layer = gather(ne, [&](Index e, std::vector<int>& rs) {
       for (int a = 0; a < k; ++a)
         for (int q : star.of(wm.element(e)[a])) rs.push_back(q);
@@ -198,7 +197,7 @@ Index number_split_nodes(Model& m, Index first, std::uint64_t revision, const De
   SHATTER_REQUIRE(m.bc_mask.size() == static_cast<size_t>(nn), "number_split_nodes: the model's node arrays are not grown");
   auto owner = [&](Index n) {
     int r = dec.size();
-    for (Index e : node_star(mesh, n)) r = std::min(r, part.granule_rank[part.element_index[e] / ElementForces::kGranule]);
+    for (Index e : node_star(mesh, n)) r = std::min(r, dec.element_rank(e));
     return r;
   };
   // Names, doubled, plus one for a copy with a prescribed component.
