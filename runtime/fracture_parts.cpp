@@ -3,6 +3,10 @@
 // model's fracture state from the owners; a restart on parts gives each part
 // its share of it.
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <tuple>
+#include <type_traits>
 
 #include "kernels/error.hpp"
 #include "runtime/fracture_stage.hpp"
@@ -11,15 +15,31 @@
 namespace shatter {
 namespace {
 
-/// Per node: reference, bc_velocity, initial_velocity, mass, node_gid,
-/// node_body, bc_mask, bc_condition (integers below 2^53 travel exactly as doubles).
-constexpr int kNodeValues = 16;
+/// Values travel as doubles (integers below 2^53 exactly): put appends one, take
+/// reads one and moves past it.
+void put(std::vector<double>& to, const Vec3& v) { to.insert(to.end(), v.data(), v.data() + 3); }
+void put(std::vector<double>& to, const std::array<std::int32_t, 3>& a) { to.insert(to.end(), a.begin(), a.end()); }
+template <class T>
+  requires std::is_arithmetic_v<T>
+void put(std::vector<double>& to, T a) {
+  to.push_back(static_cast<double>(a));
+}
+void take(const double*& v, Vec3& x) { x = Vec3(v[0], v[1], v[2]), v += 3; }
+void take(const double*& v, std::array<std::int32_t, 3>& a) {
+  for (auto& c : a) c = static_cast<std::int32_t>(*v++);
+}
+template <class T>
+  requires std::is_arithmetic_v<T>
+void take(const double*& v, T& a) {
+  a = static_cast<T>(*v++);
+}
+
+/// Per node, every array of node_arrays (FractureState): reference, node_gid,
+/// node_body, mass, bc_mask, bc_velocity, bc_condition, initial_velocity.
+constexpr int kNodeValues = 3 + 1 + 1 + 1 + 1 + 3 + 3 + 3;
 /// Per cohesive element: facet gid and state, side_local and side_nodes
 /// (whole ids), area, normal, delta_max.
 constexpr int kCohesiveValues = 2 + 2 * kCohesiveSlots + 1 + 3 + kCohesivePoints;
-
-void append(std::vector<double>& to, const Vec3& v) { to.insert(to.end(), v.data(), v.data() + 3); }
-Vec3 vec3(const double* v) { return Vec3(v[0], v[1], v[2]); }
 
 }  // namespace
 
@@ -34,12 +54,7 @@ FractureState FractureStage::gather(const FractureState& mine) const {
   for (Index n : dec_.touched_nodes()) {
     if (n >= nodes || dec_.node_owner(n) != dec_.rank()) continue;
     rows.push_back(m.whole_node(n));
-    append(values, mine.reference[n]);
-    append(values, mine.bc_velocity[n]);
-    append(values, mine.initial_velocity[n]);
-    values.insert(values.end(), {mine.mass[n], static_cast<double>(mine.node_gid[n]),
-                                 static_cast<double>(mine.node_body[n]), static_cast<double>(mine.bc_mask[n])});
-    for (int c = 0; c < 3; ++c) values.push_back(mine.bc_condition[n][c]);
+    std::apply([&](const auto&... a) { (put(values, a[n]), ...); }, node_arrays(mine));
   }
   const std::vector<double> node_rows = to_root(rows, values, kNodeValues, mine.whole_nodes, dec_.comm());
   // Each element's nodes from its owner.
@@ -61,15 +76,14 @@ FractureState FractureStage::gather(const FractureState& mine) const {
     const auto at = std::lower_bound(mine.facet_gid.begin(), mine.facet_gid.end(), gid) - mine.facet_gid.begin();
     values.insert(values.end(), {static_cast<double>(gid), static_cast<double>(mine.facet_state[at])});
     const size_t slots = static_cast<size_t>(c) * kCohesiveSlots;
-    for (int j = 0; j < kCohesiveSlots; ++j) values.push_back(mine.cohesive.side_local[slots + j]);
+    for (int j = 0; j < kCohesiveSlots; ++j) put(values, mine.cohesive.side_local[slots + j]);
     for (int j = 0; j < kCohesiveSlots; ++j) {
       const Index n = mine.cohesive.side_nodes[slots + j];
-      values.push_back(n < 0 ? -1.0 : static_cast<double>(m.whole_node(n)));
+      put(values, n < 0 ? Index{-1} : m.whole_node(n));
     }
-    values.push_back(mine.cohesive.area[c]);
-    append(values, mine.cohesive.normal[c]);
-    const double* d = mine.cohesive.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
-    values.insert(values.end(), d, d + kCohesivePoints);
+    put(values, mine.cohesive.area[c]);
+    put(values, mine.cohesive.normal[c]);
+    for (int q = 0; q < kCohesivePoints; ++q) put(values, mine.cohesive.delta_max[static_cast<size_t>(c) * kCohesivePoints + q]);
   }
   const std::vector<double> cohesive_rows =
       to_root(rows, values, kCohesiveValues, mine.whole_cohesive, dec_.comm());
@@ -79,31 +93,22 @@ FractureState FractureStage::gather(const FractureState& mine) const {
   w.mesh_revision = mine.mesh_revision;
   w.whole_nodes = mine.whole_nodes;
   w.whole_cohesive = mine.whole_cohesive;
-  for (Index n = 0; n < mine.whole_nodes; ++n) {
-    const double* v = node_rows.data() + static_cast<size_t>(n) * kNodeValues;
-    w.reference.push_back(vec3(v));
-    w.bc_velocity.push_back(vec3(v + 3));
-    w.initial_velocity.push_back(vec3(v + 6));
-    w.mass.push_back(v[9]);
-    w.node_gid.push_back(static_cast<GlobalId>(v[10]));
-    w.node_body.push_back(static_cast<int>(v[11]));
-    w.bc_mask.push_back(static_cast<std::uint8_t>(v[12]));
-    w.bc_condition.push_back(
-        {static_cast<std::int32_t>(v[13]), static_cast<std::int32_t>(v[14]), static_cast<std::int32_t>(v[15])});
-  }
+  const double* row = node_rows.data();
+  for (Index n = 0; n < mine.whole_nodes; ++n)
+    std::apply([&](auto&... a) { (take(row, a.emplace_back()), ...); }, node_arrays(w));
   for (double a : conn_rows) w.conn.push_back(static_cast<Index>(a));
   std::vector<std::pair<GlobalId, FacetState>> facets;
   for (Index c = 0; c < mine.whole_cohesive; ++c) {
-    const double* v = cohesive_rows.data() + static_cast<size_t>(c) * kCohesiveValues;
-    const auto gid = static_cast<GlobalId>(v[0]);
-    facets.emplace_back(gid, static_cast<FacetState>(v[1]));
+    const double* r = cohesive_rows.data() + static_cast<size_t>(c) * kCohesiveValues;
+    const auto gid = static_cast<GlobalId>(r[0]);
+    facets.emplace_back(gid, static_cast<FacetState>(r[1]));
+    r += 2;
     w.cohesive_facet_gid.push_back(gid);
-    for (int j = 0; j < kCohesiveSlots; ++j) w.cohesive.side_local.push_back(static_cast<std::int8_t>(v[2 + j]));
-    for (int j = 0; j < kCohesiveSlots; ++j) w.cohesive.side_nodes.push_back(static_cast<Index>(v[2 + kCohesiveSlots + j]));
-    const double* rest = v + 2 + 2 * kCohesiveSlots;
-    w.cohesive.area.push_back(rest[0]);
-    w.cohesive.normal.push_back(vec3(rest + 1));
-    w.cohesive.delta_max.insert(w.cohesive.delta_max.end(), rest + 4, rest + 4 + kCohesivePoints);
+    for (int j = 0; j < kCohesiveSlots; ++j) take(r, w.cohesive.side_local.emplace_back());
+    for (int j = 0; j < kCohesiveSlots; ++j) take(r, w.cohesive.side_nodes.emplace_back());
+    take(r, w.cohesive.area.emplace_back());
+    take(r, w.cohesive.normal.emplace_back());
+    for (int q = 0; q < kCohesivePoints; ++q) take(r, w.cohesive.delta_max.emplace_back());
     w.cohesive_whole.push_back(c);
   }
   // Every facet that is not intact has a cohesive element.
