@@ -289,9 +289,11 @@ void FractureStage::restore(const FractureState& whole) {
   ++facet_revision_;
   cohesive_ = s.cohesive;
   cohesive_.facet = cohesive_facets;
-  whole_cohesive_ = model_.holds_two_layers() ? s.whole_cohesive : cohesive_.size();
-  cohesive_whole_ = s.cohesive_whole;
-  if (!model_.holds_two_layers()) {
+  if (model_.holds_two_layers()) {
+    whole_cohesive_ = s.whole_cohesive;
+    cohesive_whole_ = s.cohesive_whole;
+  } else {  // the whole model's state: its own numbering
+    whole_cohesive_ = cohesive_.size();
     cohesive_whole_.resize(cohesive_.size());
     std::iota(cohesive_whole_.begin(), cohesive_whole_.end(), 0);
   }
