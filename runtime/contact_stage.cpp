@@ -58,7 +58,7 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 
 bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
-  if (!body_pairs_.empty() || !self_ || any_free_rigid_) {
+  if (by_body()) {
     const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
     if (!self_ && a == b) return true;
     // Free rigid bodies touch deformable ones only (DCR moves one rigid body per pair;
@@ -87,7 +87,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   }
   have_candidates_ = false;
   pairs_.clear();
-  if (!body_pairs_.empty() || !self_ || any_free_rigid_) node_body_ = mesh.node_body;
+  if (by_body()) node_body_ = mesh.node_body;
   if (!dec_) return;
   triangle_order_.resize(surface_.triangles.size());
   std::iota(triangle_order_.begin(), triangle_order_.end(), 0);

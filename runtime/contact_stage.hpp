@@ -134,6 +134,8 @@ class ContactStage {
   /// (rebuild), its bodies are not a pair of contact.pairs, they are one body and
   /// contact.self is false, or both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
+  /// Whether excluded() reads the pairs' bodies (node_body_).
+  bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_; }
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
