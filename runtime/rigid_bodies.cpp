@@ -179,18 +179,21 @@ void RigidBodies::gather_forces(std::span<const Vec3> x, const SurfaceLoads* loa
   std::vector<std::array<double, 6>> load(states_.size(), std::array<double, 6>{});
   // Every rank sums (collective), those without loaded faces too.
   if (!model_.scene.loads.empty()) {
-    std::vector<Vec3> f(model_.mesh.num_nodes(), Vec3::Zero());
-    std::vector<char> loaded(model_.mesh.num_nodes(), 0);
-    for (size_t k = 0; loads && k < loads->nodes().size(); ++k) {
-      const Index i = loads->nodes()[k];
-      f[i] += loads->force()[k];
-      loaded[i] = 1;
+    // (Scratch kept between steps: the loaded nodes are a few, the mesh's nodes many.)
+    load_force_.resize(model_.mesh.num_nodes(), Vec3::Zero());
+    loaded_.resize(model_.mesh.num_nodes(), 0);
+    const std::span<const Index> nodes = loads ? loads->nodes() : std::span<const Index>{};
+    for (size_t k = 0; k < nodes.size(); ++k) {
+      load_force_[nodes[k]] += loads->force()[k];
+      loaded_[nodes[k]] = 1;
     }
     load = body_sums<6>([&](Index i, int b, std::array<double, 6>& t) {
-      if (!loaded[i]) return;
-      const Vec3 tau = (x[i] - states_[b].centre).cross(f[i]);
-      for (int c = 0; c < 3; ++c) t[c] = f[i][c], t[3 + c] = tau[c];
+      if (!loaded_[i]) return;
+      const Vec3& f = load_force_[i];
+      const Vec3 tau = (x[i] - states_[b].centre).cross(f);
+      for (int c = 0; c < 3; ++c) t[c] = f[c], t[3 + c] = tau[c];
     });
+    for (const Index i : nodes) load_force_[i] = Vec3::Zero(), loaded_[i] = 0;
   }
   for (size_t b = 0; b < states_.size(); ++b) {
     if (prescribed_[b]) continue;  // its conditions' reactions take them

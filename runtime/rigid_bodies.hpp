@@ -98,6 +98,10 @@ class RigidBodies {
   std::vector<Vec3> arm_;     ///< per nodes_: s_i, its arm in the principal frame, m
   std::vector<Vec3> centre_old_;       ///< per body: c(n) during a step
   std::vector<Mat3> orientation_old_;  ///< per body: R(n) during a step
+  /// gather_forces' scratch, per node (zero and 0 between calls): the loads' force, and
+  /// whether a load acts on the node
+  std::vector<Vec3> load_force_;
+  std::vector<char> loaded_;
   std::vector<DcrRigidBodies::Body> mobility_;
   DcrRigidBodies dcr_;
 };
