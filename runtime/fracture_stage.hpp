@@ -2,6 +2,7 @@
 // Step 5 of the time loop (DESIGN.md): the facet check, extrinsic insertion
 // of cohesive elements with node splitting, cohesive forces and fragments,
 // for scenes with a material that has a fracture block.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -187,6 +188,11 @@ class FractureStage {
   /// The whole model's cohesive elements whose two elements two ranks own
   /// (cracks across subdomains; collective).
   long across_ranks() const;
+  /// The cohesive elements this rank owns (computes and frees).
+  long owned_count() const {
+    return dec_.distributed() ? static_cast<long>(std::count(owned_.begin(), owned_.end(), std::uint8_t{1}))
+                              : static_cast<long>(cohesive_.size());
+  }
 
  private:
   Model& model_;

@@ -173,6 +173,7 @@ class Simulation {
     CrackArea crack;              ///< the crack surface at the end (write_fragments)
     long across_ranks = 0;        ///< FractureStage::across_ranks
     double check_cpu_max = 0, insert_cpu_max = 0;  ///< the largest rank's thread CPU time, s
+    long owned_min = 0, owned_max = 0;  ///< cohesive elements a rank owns, fewest and most
   };
   /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
   void write_summary(double wall_seconds, const DecompositionStats& stats, const ContactBalance& contact_balance,

@@ -220,6 +220,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
     j.add("fracture_insert_cpu_time_max", fracture.insert_cpu_max);
     // Cohesive elements between elements of different ranks: cracks across subdomains.
     j.add("cohesive_elements_across_ranks", fracture.across_ranks);
+    j.add("cohesive_elements_per_rank_min", fracture.owned_min);
+    j.add("cohesive_elements_per_rank_max", fracture.owned_max);
     j.add("crack_area_debonded", fracture.crack.debonded.value());
     j.add("crack_area_between_fragments", fracture.crack.between_fragments.value());
     j.add("cohesive_dissipated_debonded", fracture.crack.debonded_dissipated.value());

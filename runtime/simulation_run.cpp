@@ -111,7 +111,8 @@ long Simulation::run() {
     if (fracture_) {
       double cpu[2] = {fracture_->check_cpu_seconds(), insert_cpu_seconds_};
       dec_->max(cpu);
-      fracture = {write_fragments(), fracture_->across_ranks(), cpu[0], cpu[1]};
+      const long owned = fracture_->owned_count();
+      fracture = {write_fragments(), fracture_->across_ranks(), cpu[0], cpu[1], -dec_->max(-owned), dec_->max(owned)};
     }
     const DecompositionStats stats = dec_->stats();
     const ContactBalance pairs = contact_ ? contact_->balance() : ContactBalance{};

@@ -12,9 +12,11 @@
 #             ranks at 3 ranks (cracks crossing subdomain boundaries), and
 #             without contact each rank held only its part (two ghost layers):
 #             model_bytes_per_rank_max below 0.85x that of 1 rank;
+#   local_fracture: as fracture, but the cracks stay on one rank: at 3 ranks a
+#             rank owns no cohesive element and another owns them all;
 #   volume:   (no contact, no fracture) at 3 ranks each rank held only its
 #             part of the model: model_bytes_per_rank_max below 0.6x that of 1 rank.
-# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture|volume [--set key=value ...]
+# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture|local_fracture|volume [--set key=value ...]
 set -euo pipefail
 shatter=$1 mpiexec=$2 scene=$3 work=$4 kind=$5
 shift 5
@@ -33,7 +35,7 @@ run 4 1
 bytes() { grep -o '"model_bytes_per_rank_max": [0-9]*' "$work/$1/summary.json" | grep -o '[0-9]*$'; }
 status=0
 for d in r2t1 r1t2 r3t1 r4t1; do
-  for f in history.csv bodies.csv $([ "$kind" = fracture ] && echo fragments.csv); do
+  for f in history.csv bodies.csv $([ "$kind" != contact ] && [ "$kind" != volume ] && echo fragments.csv); do
     if ! cmp -s "$work/r1t1/$f" "$work/$d/$f"; then
       echo "FAIL: $d/$f differs from r1t1/$f:"
       diff "$work/r1t1/$f" "$work/$d/$f" | head -4
@@ -69,8 +71,16 @@ elif [ "$kind" = volume ]; then
   awk -v a="$three" -v b="$one" 'BEGIN { exit !(a < 0.6 * b) }' && n=1 || n=0
   what="model bytes per rank $three at 3 ranks, $one at 1"
 else
-  n=$(grep -o '"cohesive_elements_across_ranks": [0-9]*' "$work/r3t1/summary.json" | grep -o '[0-9]*$')
-  what="$n cohesive elements across ranks at 3 ranks"
+  key() { grep -o "\"$1\": [0-9]*" "$work/r3t1/summary.json" | grep -o '[0-9]*$'; }
+  if [ "$kind" = local_fracture ]; then
+    least=$(key cohesive_elements_per_rank_min) n=$(key cohesive_elements_per_rank_max)
+    [ "${least:-1}" -eq 0 ] && [ "$n" -eq "$(key cohesive_elements)" ] ||
+      { echo "FAIL: at 3 ranks the ranks own $least to $n of $(key cohesive_elements) cohesive elements: the cracks are not on one rank"; status=1; }
+    what="at 3 ranks one rank owns all $n cohesive elements, another none"
+  else
+    n=$(key cohesive_elements_across_ranks)
+    what="$n cohesive elements across ranks at 3 ranks"
+  fi
   if ! grep -q '^contact:' "$scene"; then
     # Without contact a fracture scene runs on parts (two ghost layers).
     one=$(bytes r1t1) three=$(bytes r3t1)
