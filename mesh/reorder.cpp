@@ -54,6 +54,13 @@ MeshPermutation reorder_for_locality(Mesh& mesh, GlobalIdPolicy gids) {
     lo = lo.cwiseMin(X);
     hi = hi.cwiseMax(X);
   }
+  // The curve in a cube around the mesh, one scale for every axis: its halves
+  // then split the longest side first, and a run of consecutive elements of an
+  // elongated body (a bar, a plate) is a compact piece of it. (A box of the
+  // mesh's own proportions split a bar's thickness first: a granule of a
+  // 12:1 bar spanned half its length, and at 2 ranks a part's two ghost
+  // layers held all but 2 of its 4318 elements.)
+  hi = lo + Vec3::Constant((hi - lo).maxCoeff());
   // Element order: Morton code of the corner centroid, stable on ties.
   std::vector<std::uint64_t> code(ne);
   for (Index e = 0; e < ne; ++e) {

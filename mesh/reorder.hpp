@@ -31,7 +31,8 @@ enum class GlobalIdPolicy {
              ///< sorts by gid inherits the locality on every rank
 };
 
-/// Reorder elements along the Morton curve of their reference centroids
+/// Reorder elements along the Morton curve of their reference centroids (in
+/// the cube of the mesh's largest extent, from its lower corner)
 /// (ties keep the old order) and nodes by first use in the new element order
 /// (nodes used by no element keep their relative order, at the end).
 /// Every per-node and per-element array of the mesh is permuted, global ids
