@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstring>
 #include <fstream>
+#include <span>
 #include <sstream>
 
 #include "kernels/error.hpp"
@@ -276,37 +277,51 @@ struct Reader {
   std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected) const {
     return array<Vec3>(group, name, expected, 3);
   }
-  /// The rows `keep` (ascending) of a dataset of `expected` Vec3 rows, read
-  /// block by block: the whole dataset's hash is checked, and memory holds
-  /// one block and the kept rows (a part's rows of a whole-model array).
-  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected, std::span<const Index> keep) const {
+  /// Reads a dataset written by Writer::array (`expected` rows of `cols`
+  /// numbers) block by block, calling visit(first row, the block's values):
+  /// memory holds one block, and the whole dataset's hash is checked.
+  template <class T, class Visit>
+  void blocks(hid_t group, const char* name, std::size_t expected, hsize_t cols, Visit visit) const {
     H5Handle dset(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
-    require(dset.valid(),
-            std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
+    require(dset.valid(), std::string("dataset ") + name + " is missing (truncated or corrupted checkpoint?)");
     H5Handle space(H5Dget_space(dset.get()), H5Sclose);
-    require_shape(space, name, expected, 3);
+    require_shape(space, name, expected, cols);
     constexpr hsize_t kBlock = 1 << 16;
-    std::vector<Vec3> block, out;
-    out.reserve(keep.size());
+    std::vector<T> block;
     std::uint64_t h = fnv1a(nullptr, 0);
-    size_t k = 0;
     for (hsize_t first = 0; first < expected; first += kBlock) {
-      const std::array<hsize_t, 2> start{first, 0}, count{std::min<hsize_t>(kBlock, expected - first), 3};
-      block.resize(count[0]);
+      const std::array<hsize_t, 2> start{first, 0}, count{std::min<hsize_t>(kBlock, expected - first), cols};
+      block.resize(count[0] * cols / FileType<T>::numbers);
       H5Handle memory(H5Screate_simple(2, count.data(), nullptr), H5Sclose);
       require(memory.valid() &&
                   H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr) >= 0 &&
-                  H5Dread(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, block.data()) >= 0,
+                  H5Dread(dset.get(), FileType<T>::memory(), memory.get(), space.get(), H5P_DEFAULT, block.data()) >= 0,
               std::string("cannot read dataset ") + name + " (truncated or corrupted checkpoint?)");
-      h = fnv1a(block.data(), block.size() * sizeof(Vec3), h);
-      for (; k < keep.size() && static_cast<hsize_t>(keep[k]) < first + count[0]; ++k)
-        out.push_back(block[keep[k] - first]);
+      h = fnv1a(block.data(), block.size() * sizeof(T), h);
+      visit(static_cast<std::size_t>(first), std::span<const T>(block));
     }
-    require(k == keep.size(), std::string("dataset ") + name + " has fewer rows than the model");
     std::uint64_t stored = 0;
     attribute(dset.get(), "fnv1a64", H5T_NATIVE_UINT64, &stored);
     require(stored == h, std::string("dataset ") + name + " fails its hash check (corrupted checkpoint)");
+  }
+  /// The rows `keep` (ascending) of such a dataset, read by blocks(): a
+  /// part's rows of a whole-model array.
+  template <class T>
+  std::vector<T> array(hid_t group, const char* name, std::size_t expected, hsize_t cols,
+                       std::span<const Index> keep) const {
+    const std::size_t per = cols / FileType<T>::numbers;
+    std::vector<T> out;
+    out.reserve(keep.size() * per);
+    std::size_t k = 0;
+    blocks<T>(group, name, expected, cols, [&](std::size_t first, std::span<const T> block) {
+      for (; k < keep.size() && static_cast<std::size_t>(keep[k]) < first + block.size() / per; ++k)
+        out.insert(out.end(), block.begin() + (keep[k] - first) * per, block.begin() + (keep[k] - first + 1) * per);
+    });
+    require(k == keep.size(), std::string("dataset ") + name + " has fewer rows than the model");
     return out;
+  }
+  std::vector<Vec3> rows(hid_t group, const char* name, std::size_t expected, std::span<const Index> keep) const {
+    return array<Vec3>(group, name, expected, 3, keep);
   }
 };
 
@@ -480,6 +495,97 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
   sync_path(dir, O_RDONLY | O_DIRECTORY);
 }
 
+namespace {
+
+/// The whole model's fracture state, as written.
+void read_fracture_whole(const Reader& r, hid_t fr, const Model& model, std::size_t elements, std::size_t facets,
+                         FractureState& f) {
+  const auto n = static_cast<std::size_t>(f.whole_nodes), nc = static_cast<std::size_t>(f.whole_cohesive);
+  f.reference = r.rows(fr, "reference", n);
+  f.node_gid = r.array<GlobalId>(fr, "node_gid", n);
+  f.node_body = r.array<int>(fr, "node_body", n);
+  f.conn = r.array<Index>(fr, "conn", elements, model.mesh.nodes_per_element());
+  f.mass = r.array<double>(fr, "mass", n);
+  f.bc_mask = r.array<std::uint8_t>(fr, "bc_mask", n);
+  f.bc_velocity = r.rows(fr, "bc_velocity", n);
+  f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3);
+  f.initial_velocity = r.rows(fr, "initial_velocity", n);
+  f.facet_gid = r.array<GlobalId>(fr, "facet_gid", facets);
+  f.facet_state = r.array<FacetState>(fr, "facet_state", facets);
+  CohesiveElements& c = f.cohesive;
+  f.cohesive_facet_gid = r.array<GlobalId>(fr, "cohesive_facet", nc);
+  c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots);
+  c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots);
+  c.area = r.array<double>(fr, "cohesive_area", nc);
+  c.normal = r.rows(fr, "cohesive_normal", nc);
+  c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints);
+}
+
+/// A part's share of a checkpoint's fracture state (docs/parallel.md "Fracture
+/// on parts"), read block by block: the conn rows of its elements, the rows of
+/// their nodes, and the facets and cohesive elements of facets one of whose
+/// elements it holds (FractureStage::restore keeps those it holds both of).
+void read_fracture_part(const Reader& r, hid_t fr, const Model& model, std::size_t elements, std::size_t facets,
+                        FractureState& f) {
+  const auto n = static_cast<std::size_t>(f.whole_nodes), nc = static_cast<std::size_t>(f.whole_cohesive);
+  const int k = model.mesh.nodes_per_element();
+  f.conn = r.array<Index>(fr, "conn", elements, k, model.part.element_index);
+  f.node_rows = f.conn;
+  std::sort(f.node_rows.begin(), f.node_rows.end());
+  f.node_rows.erase(std::unique(f.node_rows.begin(), f.node_rows.end()), f.node_rows.end());
+  r.require(f.node_rows.empty() || (f.node_rows.front() >= 0 && static_cast<std::size_t>(f.node_rows.back()) < n),
+            "/fracture/conn names a node out of range (corrupted checkpoint?)");
+  const std::span<const Index> rows = f.node_rows;
+  f.reference = r.rows(fr, "reference", n, rows);
+  f.node_gid = r.array<GlobalId>(fr, "node_gid", n, 1, rows);
+  f.node_body = r.array<int>(fr, "node_body", n, 1, rows);
+  f.mass = r.array<double>(fr, "mass", n, 1, rows);
+  // The bc mask of the rows, and each prescribed row's rank among the whole model's.
+  std::size_t next = 0;
+  r.blocks<std::uint8_t>(fr, "bc_mask", n, 1, [&](std::size_t first, std::span<const std::uint8_t> block) {
+    for (std::size_t i = 0; i < block.size(); ++i) {
+      const bool kept = next < rows.size() && static_cast<std::size_t>(rows[next]) == first + i;
+      if (kept) {
+        f.bc_mask.push_back(block[i]);
+        if (block[i]) f.bc_rows.push_back(f.whole_bc_nodes);
+        ++next;
+      }
+      f.whole_bc_nodes += block[i] != 0;
+    }
+  });
+  f.bc_velocity = r.rows(fr, "bc_velocity", n, rows);
+  f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3, rows);
+  f.initial_velocity = r.rows(fr, "initial_velocity", n, rows);
+  // Facets by global id, 4 g + face with g the smaller element's: those of the part's elements.
+  std::vector<GlobalId> held(model.mesh.elem_gid.begin(), model.mesh.elem_gid.end());
+  std::sort(held.begin(), held.end());
+  auto of_part = [&](GlobalId facet) { return std::binary_search(held.begin(), held.end(), facet / 4); };
+  // (Each dataset is read once: the whole file's digest counts every hash read.)
+  auto picked = [&](const char* name, std::size_t count, std::vector<GlobalId>& gids) {
+    std::vector<Index> keep;
+    r.blocks<GlobalId>(fr, name, count, 1, [&](std::size_t first, std::span<const GlobalId> block) {
+      for (std::size_t i = 0; i < block.size(); ++i)
+        if (of_part(block[i])) {
+          keep.push_back(static_cast<Index>(first + i));
+          gids.push_back(block[i]);
+        }
+    });
+    return keep;
+  };
+  const std::vector<Index> open = picked("facet_gid", facets, f.facet_gid);
+  f.facet_state = r.array<FacetState>(fr, "facet_state", facets, 1, open);
+  f.cohesive_whole = picked("cohesive_facet", nc, f.cohesive_facet_gid);
+  const std::span<const Index> mine = f.cohesive_whole;
+  CohesiveElements& c = f.cohesive;
+  c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots, mine);
+  c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots, mine);
+  c.area = r.array<double>(fr, "cohesive_area", nc, 1, mine);
+  c.normal = r.rows(fr, "cohesive_normal", nc, mine);
+  c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints, mine);
+}
+
+}  // namespace
+
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model, CheckpointRun* run) {
   const Reader r{path.string(), {}};
   r.require(std::filesystem::is_regular_file(path), "no such file");
@@ -559,25 +665,13 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
     n = static_cast<std::size_t>(fn);
     FractureState& f = s.fracture.emplace();
     r.attribute(fr, "mesh_revision", H5T_NATIVE_UINT64, &f.mesh_revision);
-    f.reference = r.rows(fr, "reference", n);
-    f.node_gid = r.array<GlobalId>(fr, "node_gid", n);
-    f.node_body = r.array<int>(fr, "node_body", n);
-    f.conn = r.array<Index>(fr, "conn", static_cast<std::size_t>(elements), model.mesh.nodes_per_element());
-    f.mass = r.array<double>(fr, "mass", n);
-    f.bc_mask = r.array<std::uint8_t>(fr, "bc_mask", n);
-    f.bc_velocity = r.rows(fr, "bc_velocity", n);
-    f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3);
-    f.initial_velocity = r.rows(fr, "initial_velocity", n);
-    f.facet_gid = r.array<GlobalId>(fr, "facet_gid", static_cast<std::size_t>(facets));
-    f.facet_state = r.array<FacetState>(fr, "facet_state", static_cast<std::size_t>(facets));
-    CohesiveElements& c = f.cohesive;
-    const auto nc = static_cast<std::size_t>(cohesive);
-    f.cohesive_facet_gid = r.array<GlobalId>(fr, "cohesive_facet", nc);
-    c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots);
-    c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots);
-    c.area = r.array<double>(fr, "cohesive_area", nc);
-    c.normal = r.rows(fr, "cohesive_normal", nc);
-    c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints);
+    f.whole_nodes = static_cast<Index>(fn);
+    f.whole_cohesive = static_cast<Index>(cohesive);
+    if (model.is_part()) {
+      read_fracture_part(r, fr, model, static_cast<std::size_t>(elements), static_cast<std::size_t>(facets), f);
+    } else {
+      read_fracture_whole(r, fr, model, static_cast<std::size_t>(elements), static_cast<std::size_t>(facets), f);
+    }
   }
   s.step = r.integer(root, "step");
   s.time = r.number(root, "time");
@@ -599,18 +693,20 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
     for (std::size_t k = 0; k < rigid; ++k) s.rigid.push_back(rigid_from_rows(rows.data() + kRigidRows * k));
   }
   std::size_t b = 0;
-  if (model.is_part() && !s.fracture) b = model.part.whole_bc_nodes;
-  else for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
-  if (model.is_part() && !s.fracture) {
-    // A part reads its own rows (the whole state never in memory).
-    const std::span<const Index> nodes = model.part.node_index;
+  if (model.is_part()) {
+    // A part reads its own rows (the whole state never in memory): with fracture
+    // those of its elements' nodes after the splits (read_fracture_part).
+    const FractureState* f = s.fracture ? &*s.fracture : nullptr;
+    b = f ? f->whole_bc_nodes : model.part.whole_bc_nodes;
+    const std::span<const Index> nodes = f ? f->node_rows : model.part.node_index;
     s.x = r.rows(state.get(), "positions", n, nodes);
     s.v = r.rows(state.get(), "velocities", n, nodes);
     s.a = r.rows(state.get(), "accelerations", n, nodes);
     s.f_int = r.rows(state.get(), "internal_forces", n, nodes);
     s.f_ext = r.rows(state.get(), "external_forces", n, nodes);
-    s.reaction = r.rows(state.get(), "reactions", b, model.part.bc_index);
+    s.reaction = r.rows(state.get(), "reactions", b, f ? std::span<const Index>(f->bc_rows) : model.part.bc_index);
   } else {
+    for (std::uint8_t m : s.fracture ? s.fracture->bc_mask : model.bc_mask) b += m != 0;
     s.x = r.rows(state.get(), "positions", n);
     s.v = r.rows(state.get(), "velocities", n);
     s.a = r.rows(state.get(), "accelerations", n);

@@ -1,7 +1,7 @@
 // FractureStage's state between the whole model and the ranks' parts
 // (docs/parallel.md "Fracture on parts"): a checkpoint gathers the whole
-// model's fracture state from the owners; a restart on parts gives each part
-// its share of it.
+// model's fracture state from the owners; at a restart on parts each part
+// reads its own rows of it (read_checkpoint) and takes them in (part_of).
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -120,67 +120,53 @@ FractureState FractureStage::gather(const FractureState& mine) const {
   return w;
 }
 
-FractureState FractureStage::part_of(const FractureState& whole) {
+FractureState FractureStage::part_of(const FractureState& read) {
   const Mesh& mesh = model_.mesh;
   Model::Part& part = model_.part;
   const int k = mesh.nodes_per_element();
-  const size_t wn = whole.reference.size();
-  SHATTER_REQUIRE(whole.conn.size() == static_cast<size_t>(model_.whole_elements()) * k && whole.node_gid.size() == wn &&
-                      whole.node_body.size() == wn && whole.mass.size() == wn && whole.bc_mask.size() == wn &&
-                      whole.bc_velocity.size() == wn && whole.bc_condition.size() == wn &&
-                      whole.initial_velocity.size() == wn,
-                  "fracture state: node arrays of " << wn << " nodes and " << whole.conn.size() / k
-                                                    << " elements do not fit the model ("
-                                                    << model_.whole_elements() << " elements)");
-  // The part's nodes: those of its elements, ascending by whole index.
-  std::vector<Index> nodes;
-  for (Index e = 0; e < mesh.num_elements(); ++e)
-    for (int a = 0; a < k; ++a) {
-      const Index w = whole.conn[static_cast<size_t>(model_.whole_element(e)) * k + a];
-      SHATTER_REQUIRE(w >= 0 && static_cast<size_t>(w) < wn, "fracture state: node " << w << " in conn is out of range");
-      nodes.push_back(w);
-    }
-  std::sort(nodes.begin(), nodes.end());
-  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  const std::vector<Index>& nodes = read.node_rows;  // whole indices, ascending
+  const size_t rn = nodes.size();
+  SHATTER_REQUIRE(read.conn.size() == static_cast<size_t>(mesh.num_elements()) * k && read.reference.size() == rn &&
+                      read.node_gid.size() == rn && read.node_body.size() == rn && read.mass.size() == rn &&
+                      read.bc_mask.size() == rn && read.bc_velocity.size() == rn && read.bc_condition.size() == rn &&
+                      read.initial_velocity.size() == rn &&
+                      read.bc_rows.size() == static_cast<size_t>(std::count_if(read.bc_mask.begin(), read.bc_mask.end(),
+                                                                               [](std::uint8_t m) { return m != 0; })),
+                  "fracture state: a part's rows of " << rn << " nodes and " << read.conn.size() / k
+                                                      << " elements do not fit its " << mesh.num_elements()
+                                                      << " elements");
   auto local = [&](Index w) {
     const auto it = std::lower_bound(nodes.begin(), nodes.end(), w);
     return it != nodes.end() && *it == w ? static_cast<Index>(it - nodes.begin()) : Index{-1};
   };
   FractureState s;
-  s.mesh_revision = whole.mesh_revision;
-  std::vector<Index> bc_rank(wn, -1);
-  Index bc_nodes = 0;
-  for (size_t w = 0; w < wn; ++w)
-    if (whole.bc_mask[w]) bc_rank[w] = bc_nodes++;
-  part.bc_index.clear();
-  for (Index w : nodes) {
-    append_node_row(s, whole, w);
-    if (whole.bc_mask[w]) part.bc_index.push_back(bc_rank[w]);
-  }
-  for (Index e = 0; e < mesh.num_elements(); ++e)
-    for (int a = 0; a < k; ++a) s.conn.push_back(local(whole.conn[static_cast<size_t>(model_.whole_element(e)) * k + a]));
+  s.mesh_revision = read.mesh_revision;
+  copy_node_arrays(s, read);
+  for (Index w : read.conn) s.conn.push_back(local(w));
   part.node_index = nodes;
-  part.whole_nodes = static_cast<Index>(wn);
-  part.whole_bc_nodes = bc_nodes;
+  part.bc_index = read.bc_rows;
+  part.whole_nodes = read.whole_nodes;
+  part.whole_bc_nodes = read.whole_bc_nodes;
   // The facets and cohesive elements held here.
   auto held = [&](GlobalId gid) { return !facets(std::span<const GlobalId>(&gid, 1)).empty(); };
-  SHATTER_REQUIRE(whole.facet_state.size() == whole.facet_gid.size(),
-                  "fracture state: " << whole.facet_gid.size() << " facet ids and " << whole.facet_state.size()
-                                     << " states");
-  for (size_t i = 0; i < whole.facet_gid.size(); ++i)
-    if (held(whole.facet_gid[i])) {
-      s.facet_gid.push_back(whole.facet_gid[i]);
-      s.facet_state.push_back(whole.facet_state[i]);
+  SHATTER_REQUIRE(
+      read.facet_state.size() == read.facet_gid.size(),
+      "fracture state: " << read.facet_gid.size() << " facet ids and " << read.facet_state.size() << " states");
+  for (size_t i = 0; i < read.facet_gid.size(); ++i)
+    if (held(read.facet_gid[i])) {
+      s.facet_gid.push_back(read.facet_gid[i]);
+      s.facet_state.push_back(read.facet_state[i]);
     }
-  const CohesiveElements& c = whole.cohesive;
-  const size_t nc = whole.cohesive_facet_gid.size();
-  SHATTER_REQUIRE(c.side_local.size() == nc * kCohesiveSlots && c.side_nodes.size() == nc * kCohesiveSlots &&
-                      c.area.size() == nc && c.normal.size() == nc && c.delta_max.size() == nc * kCohesivePoints,
+  const CohesiveElements& c = read.cohesive;
+  const size_t nc = read.cohesive_facet_gid.size();
+  SHATTER_REQUIRE(read.cohesive_whole.size() == nc && c.side_local.size() == nc * kCohesiveSlots &&
+                      c.side_nodes.size() == nc * kCohesiveSlots && c.area.size() == nc && c.normal.size() == nc &&
+                      c.delta_max.size() == nc * kCohesivePoints,
                   "fracture state: the cohesive element arrays disagree in size");
   for (size_t i = 0; i < nc; ++i) {
-    if (!held(whole.cohesive_facet_gid[i])) continue;
-    s.cohesive_facet_gid.push_back(whole.cohesive_facet_gid[i]);
-    s.cohesive_whole.push_back(static_cast<Index>(i));
+    if (!held(read.cohesive_facet_gid[i])) continue;
+    s.cohesive_facet_gid.push_back(read.cohesive_facet_gid[i]);
+    s.cohesive_whole.push_back(read.cohesive_whole[i]);
     for (int j = 0; j < kCohesiveSlots; ++j) {
       s.cohesive.side_local.push_back(c.side_local[i * kCohesiveSlots + j]);
       const Index w = c.side_nodes[i * kCohesiveSlots + j];
@@ -193,8 +179,8 @@ FractureState FractureStage::part_of(const FractureState& whole) {
     s.cohesive.delta_max.insert(s.cohesive.delta_max.end(), c.delta_max.begin() + i * kCohesivePoints,
                                 c.delta_max.begin() + (i + 1) * kCohesivePoints);
   }
-  s.whole_nodes = static_cast<Index>(wn);
-  s.whole_cohesive = static_cast<Index>(nc);
+  s.whole_nodes = read.whole_nodes;
+  s.whole_cohesive = read.whole_cohesive;
   return s;
 }
 

@@ -58,6 +58,12 @@ struct FractureState {
   std::vector<GlobalId> cohesive_facet_gid;
   Index whole_nodes = 0, whole_cohesive = 0;  ///< the whole model's counts
   std::vector<Index> cohesive_whole;           ///< [c]: index among the whole model's cohesive elements
+  /// A part's read of a checkpoint (read_checkpoint; FractureStage::part_of): the
+  /// node rows are those of the part's elements, node_rows their whole indices
+  /// (ascending), conn the part's elements' rows in whole indices, bc_rows each
+  /// prescribed row's rank among the whole model's whole_bc_nodes such nodes.
+  std::vector<Index> node_rows, bc_rows;
+  Index whole_bc_nodes = 0;
 };
 
 /// The state's per-node arrays, in the order of the model's (node_arrays(Model&)).
@@ -202,8 +208,9 @@ class FractureStage {
   CohesiveElements cohesive_;
   std::vector<Index> cohesive_whole_;  ///< [c]: index among the whole model's cohesive elements
   Index whole_cohesive_ = 0;           ///< the whole model's cohesive elements
-  /// The part's share of the whole model's state `whole` (restore on parts).
-  FractureState part_of(const FractureState& whole);
+  /// The part's own state from its read of a checkpoint (`read`: FractureState::node_rows;
+  /// restore on parts): local node ids, the facets and cohesive elements held here.
+  FractureState part_of(const FractureState& read);
   std::vector<std::optional<CohesiveLaw>> laws_;
   std::vector<double> facet_strength_;  ///< [f] Pa, with strength scatter only
   double weakest_facet_ = 0;            ///< min of facet_strength_, Pa

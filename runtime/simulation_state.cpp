@@ -103,26 +103,18 @@ void Simulation::restore_state(const SimulationState& s) {
     if (contact_ && model_.mesh.revision != built_revision) rebuild_contact_surface();
     share_plans();
   }
-  // On parts with fracture the state is the whole model's (a checkpoint's): this part's rows.
-  const bool whole = model_.holds_two_layers();
-  const size_t n = whole ? model_.whole_nodes() : model_.mesh.num_nodes();
-  const size_t b = whole ? model_.part.whole_bc_nodes : bc_nodes_.size();
-  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n &&
-                      s.f_ext.size() == n && s.reaction.size() == b,
+  // (A part's state holds its own rows: read_checkpoint.)
+  const size_t n = model_.mesh.num_nodes();
+  SHATTER_REQUIRE(s.x.size() == n && s.v.size() == n && s.a.size() == n && s.f_int.size() == n && s.f_ext.size() == n &&
+                      s.reaction.size() == bc_nodes_.size(),
                   "restore_state: the state has " << s.x.size() << " nodes and " << s.reaction.size()
-                                                  << " reactions, the model " << n << " and " << b);
-  auto rows = [&](const std::vector<Vec3>& from, std::span<const Index> index) {
-    if (!whole) return from;
-    std::vector<Vec3> to;
-    for (Index i : index) to.push_back(from[i]);
-    return to;
-  };
-  x_ = rows(s.x, model_.part.node_index);
-  v_ = rows(s.v, model_.part.node_index);
-  a_ = rows(s.a, model_.part.node_index);
-  f_int_ = rows(s.f_int, model_.part.node_index);
-  f_ext_ = rows(s.f_ext, model_.part.node_index);
-  reaction_ = rows(s.reaction, model_.part.bc_index);
+                                                  << " reactions, the model " << n << " and " << bc_nodes_.size());
+  x_ = s.x;
+  v_ = s.v;
+  a_ = s.a;
+  f_int_ = s.f_int;
+  f_ext_ = s.f_ext;
+  reaction_ = s.reaction;
   SHATTER_REQUIRE(s.rigid.empty() || rigid_, "restore_state: the state has " << s.rigid.size()
                                                                            << " free rigid bodies, the scene none");
   if (rigid_) rigid_->restore(s.rigid, x_, v_);

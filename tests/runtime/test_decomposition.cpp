@@ -18,6 +18,7 @@
 #include "runtime/fragment_labels.hpp"
 #include "runtime/model_part.hpp"
 #include "runtime/model.hpp"
+#include "runtime/simulation.hpp"
 #include "scene_text.hpp"
 
 namespace shatter {
@@ -328,6 +329,63 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
   if (ranks > 1) {
     EXPECT_LT(d.local_elements().size(), static_cast<size_t>(part.mesh.num_elements()));
   }
+}
+
+
+TEST(Decomposition, FractureRestartOnPartsReadsItsOwnRows) {
+  // A checkpoint of a cracked model, written by one rank: each part reads only
+  // the rows of its elements' nodes and of its facets' cohesive elements, and
+  // continues the run bit for bit.
+  const int ranks = world_size();
+  const Scene scene = rank_scene(
+      "fracture_restart_parts",
+      "name: fracture_restart_parts\ntime: {end: 1.0}\nmaterials:\n"
+      "  alu: {model: neo_hookean, density: 2750, youngs_modulus: 275.0e9, poisson_ratio: 0.3,\n"
+      "        fracture: {strength: 3.0e8, energy: 100.0, beta: 1.0}}\n"
+      "bodies:\n  - {name: b, material: alu, mesh: {shape: box, size: [0.024, 0.002, 0.002], element_size: 0.0005},\n"
+      "      velocity_gradient: [[2.0e4, 0, 0], [0, 2.0e4, 0], [0, 0, 0]]}\n");
+  Model whole = build_model(scene);
+  Simulation one(whole, {});
+  while (one.ledger().cohesive_elements == 0 && one.steps() < 400) one.step();
+  for (int s = 0; s < 20; ++s) one.step();
+  ASSERT_GT(one.ledger().cohesive_elements, 0) << "the box did not crack";
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "shatter_fracture_restart_parts.h5";
+  if (world_rank() == 0) {
+    SimulationState state;
+    one.save_state(state);
+    write_checkpoint(file, whole, state);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  Model part = build_model(scene, MPI_COMM_WORLD);
+  const SimulationState read = read_checkpoint(file, part);
+  ASSERT_TRUE(read.fracture);
+  const FractureState& f = *read.fracture;
+  EXPECT_EQ(f.whole_nodes, whole.mesh.num_nodes());
+  if (ranks > 1) {
+    ASSERT_EQ(read.x.size(), f.node_rows.size());
+    for (size_t i = 0; i < f.node_rows.size(); ++i) EXPECT_TRUE(same_bits(read.x[i], one.positions()[f.node_rows[i]]));
+    // Its own rows only: fewer nodes and cohesive elements than the whole model's.
+    EXPECT_LT(f.node_rows.size(), static_cast<size_t>(whole.mesh.num_nodes()));
+    EXPECT_LT(f.cohesive_facet_gid.size(), static_cast<size_t>(one.ledger().cohesive_elements));
+  }
+  RunOptions options;
+  options.ranks = ranks;
+  Simulation continued(part, options);
+  continued.restore_state(read);
+  for (int s = 0; s < 20; ++s) {
+    one.step();
+    continued.step();
+  }
+  EXPECT_EQ(continued.ledger().cohesive_elements, one.ledger().cohesive_elements);
+  EXPECT_EQ(continued.energy_error(), one.energy_error());
+  const Decomposition& d = continued.decomposition();
+  long checked = 0;
+  for (Index n = 0; n < part.mesh.num_nodes(); ++n)
+    if (d.owns_node(n)) {
+      EXPECT_TRUE(same_bits(continued.positions()[n], one.positions()[part.whole_node(n)])) << "node " << part.whole_node(n);
+      ++checked;
+    }
+  EXPECT_GT(checked, 0);
 }
 
 }  // namespace
