@@ -287,6 +287,8 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
   EXPECT_EQ(part.holds_two_layers(), ranks > 1);
   Decomposition d(part, MPI_COMM_WORLD);
   const Decomposition one(whole, MPI_COMM_SELF);
+  // The whole model on the ranks, partitioned before any split as the parts were.
+  Decomposition wd(whole, MPI_COMM_WORLD);
   FractureStage on_part(part, d), on_whole(whole, one);
   const Topology& wt = on_whole.topology();
   for (int round : {0, 1}) {
@@ -309,7 +311,7 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
     EXPECT_EQ(on_part.cohesive_count(), on_whole.cohesive_count()) << "round " << round;
   }
   d.rebuild_nodes(on_part.side_nodes(), kCohesiveSlots);
-  const Decomposition wd(whole, MPI_COMM_WORLD);
+  wd.rebuild_nodes(on_whole.side_nodes(), kCohesiveSlots);
   const int k = whole.mesh.nodes_per_element();
   long checked = 0;
   for (Index e : d.local_elements()) {
