@@ -164,25 +164,38 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     }
   // Send: nodes owned here to every rank holding them without touching
   // them. Rank q holds n when it touches a node of an element of n's star or
-  // of a group holding n.
-  std::vector<int> holders;
-  auto add_ranks_of = [&](Index m) {
-    if (m < 0) return;
-    for (Index q = node_rank_offsets_[m]; q < node_rank_offsets_[m + 1]; ++q) holders.push_back(node_ranks_[q]);
+  // of a group holding n. The ranks touching each element's nodes and each
+  // group's come first (CSR), then each owned node's holders are their union,
+  // marked per rank (mark[q] == n: q is listed for n), without sorting.
+  auto ranks_of_lists = [&](Index count, auto nodes_of) {
+    NodeRanks out;
+    out.offsets.assign(1, 0);
+    std::vector<Index> mark(size_, -1);
+    for (Index i = 0; i < count; ++i) {
+      for (Index m : nodes_of(i))
+        if (m >= 0)
+          for (Index q = node_rank_offsets_[m]; q < node_rank_offsets_[m + 1]; ++q)
+            if (mark[node_ranks_[q]] != i) mark[node_ranks_[q]] = i, out.ranks.push_back(node_ranks_[q]);
+      out.offsets.push_back(static_cast<Index>(out.ranks.size()));
+    }
+    return out;
   };
+  const NodeRanks element_ranks =
+      ranks_of_lists(ne, [&](Index e) { return std::span<const Index>(mesh.element(e), static_cast<size_t>(k)); });
+  const NodeRanks group_ranks = ranks_of_lists(ng, group);
+  std::vector<Index> mark(size_, -1);
   for (Index n : touched_nodes_) {
     if (node_owner(n) != rank_) continue;
-    holders.clear();
-    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p) {
-      const Index* c = mesh.element(mesh.node_elem[p]);
-      for (int a = 0; a < k; ++a) add_ranks_of(c[a]);
-    }
-    for (Index p = group_offsets[n]; p < group_offsets[n + 1]; ++p)
-      for (Index m : group(node_groups[p])) add_ranks_of(m);
-    std::sort(holders.begin(), holders.end());
-    holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
-    for (int q : holders)
-      if (!touches(n, q)) send[q].push_back(n);
+    auto send_to = [&](std::span<const int> ranks) {
+      for (int q : ranks)
+        if (mark[q] != n) {
+          mark[q] = n;
+          if (!touches(n, q)) send[q].push_back(n);
+        }
+    };
+    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
+      send_to(element_ranks.of(mesh.node_elem[p]));
+    for (Index p = group_offsets[n]; p < group_offsets[n + 1]; ++p) send_to(group_ranks.of(node_groups[p]));
   }
   halo_ = std::make_unique<Halo>(nn, exchange_from(send), exchange_from(recv), comm_, kGhostTag);
 }
