@@ -161,27 +161,7 @@ elif [ "$mode" = memory ]; then
 elif [ "$mode" = fracture ]; then
   per_rank=${3:-20000}
   max_ranks=${4:-64}
-  block="$work/block.yaml"
-  cat > "$block" <<'YAML'
-name: fracture_block
-time:
-  end: 1.0e-7
-output:
-  every: 0
-  history_every: 10
-materials:
-  alu:
-    model: neo_hookean
-    density: 2750
-    youngs_modulus: 275.0e9
-    poisson_ratio: 0.3
-    fracture: {strength: 300.0e6, energy: 100.0, beta: 1.0}
-bodies:
-  - name: block
-    material: alu
-    mesh: {shape: box, size: [1.3e-3, 1.3e-3, 1.3e-3], element_size: 1.0e-4}
-    velocity_gradient: [[2.0e4, 0, 0], [0, 2.0e4, 0], [0, 0, 2.0e4]]
-YAML
+  block="$here/fracture_block.yaml"
   out="$here/results/mpi_scaling_fracture.csv"
   echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,cohesive_elements,check_cpu_ms_per_step_max,insert_cpu_ms_per_step_max" > "$out"
   r=${FIRST:-1}
