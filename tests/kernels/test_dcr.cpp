@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <random>
+#include <span>
 #include <sstream>
 
 #include "expect_close.hpp"
@@ -50,6 +51,19 @@ Ledger ledger(const PairPoints& X, const PairPoints& V, const PairWeights& w) {
     out.kinetic += 0.5 * m * V.col(i).squaredNorm();
     out.p_scale += m * V.col(i).norm();
     out.L_scale += m * X.col(i).norm() * V.col(i).norm();
+  }
+  return out;
+}
+
+/// The same totals over a set of nodes (inverse masses w).
+Ledger ledger(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> w) {
+  Ledger out;
+  for (size_t i = 0; i < x.size(); ++i) {
+    out.p += v[i] / w[i];
+    out.L += x[i].cross(v[i]) / w[i];
+    out.kinetic += 0.5 * v[i].squaredNorm() / w[i];
+    out.p_scale += v[i].norm() / w[i];
+    out.L_scale += x[i].norm() * v[i].norm() / w[i];
   }
   return out;
 }
@@ -614,18 +628,7 @@ TEST(DcrResolvePair, RandomMultiPairImpactsConserveMomenta) {
       v[i] = Vec3(u(rng), u(rng), u(rng));
       w[i] = 1 / (1.5 + u(rng));
     }
-    auto total = [&] {
-      Ledger l;
-      for (int i = 0; i < 8; ++i) {
-        l.p += v[i] / w[i];
-        l.L += x[i].cross(v[i]) / w[i];
-        l.kinetic += 0.5 * v[i].squaredNorm() / w[i];
-        l.p_scale += v[i].norm() / w[i];
-        l.L_scale += x[i].norm() * v[i].norm() / w[i];
-      }
-      return l;
-    };
-    const Ledger before = total();
+    const Ledger before = ledger(x, v, w);
     double dissipated = 0;
     for (int k = 0; k < 200; ++k) {
       std::array<int, 4> n;
@@ -643,7 +646,7 @@ TEST(DcrResolvePair, RandomMultiPairImpactsConserveMomenta) {
       dissipated += dcr_impulse(k % 2 ? EE : VF, -1.0, X, V, wp, {e, 0.0, 1e-6}).dissipated;
       for (int i = 0; i < 4; ++i) v[n[i]] = V.col(i);
     }
-    const Ledger after = total();
+    const Ledger after = ledger(x, v, w);
     EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
     EXPECT_LT((after.L - before.L).norm(), 1e-13 * before.L_scale);
     EXPECT_CLOSE(before.kinetic - after.kinetic, dissipated, 0, 1e-13 * before.kinetic);
@@ -692,18 +695,7 @@ TEST(DcrResolvePair, ChainsOfPairsSharingNodesKeepBothMomenta) {
         for (int i = 0; i < N; ++i) x[i] += offset, v[i] += omega.cross(x[i]);  // spinning
         std::array<Vec3, N> x_new;
         for (int i = 0; i < N; ++i) x_new[i] = x[i] + dt * v[i];
-        auto totals = [&] {
-          Ledger l;
-          for (int i = 0; i < N; ++i) {
-            l.p += v[i] / w[i];
-            l.L += x_new[i].cross(v[i]) / w[i];
-            l.kinetic += 0.5 * v[i].squaredNorm() / w[i];
-            l.p_scale += v[i].norm() / w[i];
-            l.L_scale += x_new[i].norm() * v[i].norm() / w[i];
-          }
-          return l;
-        };
-        const Ledger before = totals();
+        const Ledger before = ledger(x_new, v, w);
         double accounted = 0;
         for (int round = 0; round < 20; ++round) {
           bool any = false;
@@ -724,7 +716,7 @@ TEST(DcrResolvePair, ChainsOfPairsSharingNodesKeepBothMomenta) {
           }
           if (!any) break;
         }
-        const Ledger after = totals();
+        const Ledger after = ledger(x_new, v, w);
         worst_p = std::max(worst_p, (after.p - before.p).norm() / before.p_scale);
         worst_L = std::max(worst_L, (after.L - before.L).norm() / before.L_scale);
         worst_K = std::max(worst_K, std::abs(before.kinetic - after.kinetic - accounted) / before.kinetic);
