@@ -445,8 +445,9 @@ inline double dcr_free_mass(const PairMobility& m, int i) {
 /// nodes' inertia about c). Only for pairs of four free nodes (dcr_free_mass > 0): a pair
 /// with a support or a rigid body's node is left as it was (the support takes up momenta
 /// anyway; the body is moved from its own state, RigidBodies::apply_contact). V is updated
-/// in place; returns the kinetic energy the counterpart took out, J (signed, of second order
-/// in the move), and adds the impulses m_i dv_i (summing to 0) to `applied`. Nothing is done
+/// in place; returns the kinetic energy the counterpart took out, J (signed: the work of the
+/// torque on the pair's own spin, first order in |dx| / |r|), and adds the impulses m_i dv_i
+/// (summing to 0) to `applied`. Nothing is done
 /// when dL = 0 or I is nearly singular, det I <= 1e-12 (tr I)^3 (four points nearly on one
 /// line; a triangle or two edges that detection resolves are far from it).
 template <class Weights>
