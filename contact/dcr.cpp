@@ -28,7 +28,7 @@ DcrPairKind dcr_kind(const ContactPair& p) {
 /// What resolving one found pair did.
 struct Outcome {
   bool active = false;
-  double dissipated = 0, support_work = 0;
+  double dissipated = 0, support_work = 0, work = 0;
   std::int32_t body = -1;  ///< the rigid body among the pair's nodes, -1: none
   std::array<double, kRigidSums> rigid{};  ///< what it took (DcrRigidSum)
 };
@@ -82,6 +82,7 @@ Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<c
   if (!out.active) return o;
   o.active = true;
   o.dissipated = out.impulse.dissipated;
+  o.work = out.work;
   if (body >= 0) {
     o.body = body;
     for (int i = 0; i < 4; ++i)
@@ -98,7 +99,7 @@ Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<c
     for (int i = 0; i < 4; ++i)
       for (int c = 0; c < 3; ++c)
         if (W(c, i) > 0) gained += 0.5 / W(c, i) * (V(c, i) * V(c, i) - V_before(c, i) * V_before(c, i));
-    o.support_work = gained + out.impulse.dissipated;
+    o.support_work = gained + out.impulse.dissipated + out.work;
   }
   for (int i = 0; i < 4; ++i) {
     const Index n = p.nodes[i];
@@ -323,6 +324,7 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
         resolved.push_back(found[f].pair);
         result.dissipated += outcome[f].dissipated;
         result.support_work += outcome[f].support_work;
+        result.work += outcome[f].work;
         if (outcome[f].body >= 0)
           for (int t = 0; t < kRigidSums; ++t) result.rigid[outcome[f].body][t] += outcome[f].rigid[t];
       }

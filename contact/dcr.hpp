@@ -50,7 +50,7 @@ enum DcrRigidSum { kRigidImpulse = 0, kRigidAngularImpulse = 3, kRigidShift = 6,
 
 /// Summary of one call of resolve_contacts.
 struct DcrResult {
-  // On several ranks contacts, dissipated, support_work, unresolved and detected are this
+  // On several ranks contacts, dissipated, support_work, work, unresolved and detected are this
   // rank's part (its pairs); sweeps and capped are the same on every rank.
   Index contacts = 0;       ///< distinct pairs resolved in the step (history "contacts")
   int sweeps = 0;           ///< rounds run, the last one (which found nothing, unless capped) included
@@ -59,6 +59,9 @@ struct DcrResult {
   /// pairs, through the impulses (the kinetic energy the free components gained beyond the
   /// dissipation), J; 0 when every held component is at rest.
   ExactSum support_work;
+  /// The kinetic energy the projections' angular-momentum counterpart took out
+  /// (kernels/dcr.hpp dcr_keep_angular_momentum), J, signed: the ledger's contact_work.
+  ExactSum work;
   bool capped = false;      ///< max_sweeps reached with penetrations still being found
   std::optional<ContactPair> unresolved;  ///< when capped: the first pair (canonical order) found in the last round
   Index detected = 0;       ///< pair detections (dcr_detect) run on this rank, summed over the rounds

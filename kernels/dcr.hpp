@@ -418,6 +418,71 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
   return s * pair_volume(X) > 0.0;
 }
 
+/// The node's mass for the angular-momentum counterpart of a projection (1/kg -> kg), or 0
+/// for a node that is not free: a fixed node, one with a held component, a node of a rigid
+/// body (moved by its body, PairMobility).
+template <class Derived>
+double dcr_free_mass(const Eigen::MatrixBase<Derived>& w, int i) {
+  if constexpr (Derived::RowsAtCompileTime == 3) {
+    return w.col(i).minCoeff() > 0 ? 1.0 / w.col(i).maxCoeff() : 0.0;
+  } else {
+    return w[i] > 0 ? 1.0 / w[i] : 0.0;
+  }
+}
+inline double dcr_free_mass(const PairMobility& m, int i) {
+  return m.rigid[i] || !(m.w.col(i).minCoeff() > 0) ? 0.0 : 1.0 / m.w.col(i).maxCoeff();
+}
+
+/// The velocity counterpart of a projection that keeps sum m x x v (docs/contact.md
+/// "Angular momentum: the projection's counterpart"). A move of the positions from X_before
+/// to X at fixed velocities V changes the pair's angular momentum about the origin by
+///   dL = sum_i m_i (x_i - x_before_i) x v_i
+/// (its linear momentum not at all: dcr_project keeps the centre of mass). The velocity
+/// change of least kinetic energy that gives back -dL and no linear momentum is a rigid spin
+/// of the pair's nodes about their centre of mass c at X:
+///   dv_i = Omega x (x_i - c),   I Omega = -dL,   I = sum_i m_i (|r_i|^2 1 - r_i r_i^T),
+/// since sum m_i dv_i = Omega x sum m_i r_i = 0 and sum m_i x_i x dv_i = I Omega (I the
+/// nodes' inertia about c). Only for pairs of four free nodes (dcr_free_mass > 0): a pair
+/// with a support or a rigid body's node is left as it was (the support takes up momenta
+/// anyway; the body is moved from its own state, RigidBodies::apply_contact). V is updated
+/// in place; returns the kinetic energy the counterpart took out, J (signed: the work of the
+/// torque on the pair's own spin, first order in |dx| / |r|), and adds the impulses m_i dv_i
+/// (summing to 0) to `applied`. Nothing is done
+/// when dL = 0 or I is nearly singular, det I <= 1e-12 (tr I)^3 (four points nearly on one
+/// line; a triangle or two edges that detection resolves are far from it).
+template <class Weights>
+double dcr_keep_angular_momentum(const PairPoints& X_before, const PairPoints& X, PairPoints& V,
+                                 const Weights& inv_mass, PairPoints* applied = nullptr) {
+  PairWeights m;
+  Vec3 dL = Vec3::Zero(), c = Vec3::Zero();
+  double M = 0;
+  for (int i = 0; i < 4; ++i) {
+    m[i] = dcr_free_mass(inv_mass, i);
+    if (m[i] == 0) return 0.0;
+    dL += m[i] * (X.col(i) - X_before.col(i)).cross(V.col(i));
+    c += m[i] * X.col(i);
+    M += m[i];
+  }
+  if (dL == Vec3::Zero()) return 0.0;
+  c /= M;
+  Mat3 I = Mat3::Zero();
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 r = X.col(i) - c;
+    I += m[i] * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+  }
+  const Eigen::LLT<Mat3> llt(I);
+  if (llt.info() != Eigen::Success || !(I.determinant() > 1e-12 * std::pow(I.trace(), 3))) return 0.0;
+  const Vec3 omega = -llt.solve(dL);
+  double taken = 0;
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 dv = omega.cross(X.col(i) - c);
+    taken -= m[i] * (V.col(i).dot(dv) + 0.5 * dv.squaredNorm());
+    V.col(i) += dv;
+    if (applied) applied->col(i) += m[i] * dv;
+  }
+  return taken;
+}
+
 /// The momentum transfer of one resolved pair.
 struct DcrImpulse {
   double normal = 0.0;      ///< |normal impulse| on the vertex / on edge a, N s
@@ -524,6 +589,9 @@ struct DcrPairResponse {
   /// The mass-weighted position change of each node, kg m: the projections' mu grad g and
   /// the free flight's tau times the impulse (Middle, Impact); they sum to 0.
   PairPoints shift = PairPoints::Zero();
+  /// The kinetic energy the projections' velocity counterpart took out
+  /// (dcr_keep_angular_momentum), J, signed: contact work that is not the law's dissipation.
+  double work = 0.0;
 };
 
 /// One DCR resolution of a pair over a step of the central-difference predictor
@@ -559,8 +627,12 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   const double s = pen.orientation;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
   if (law.placement == DcrPlacement::End) {
+    const PairPoints X_before = X_new;
     out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift);
+    PairPoints spin = PairPoints::Zero();
+    out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &spin);
     out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
+    out.impulse.applied += spin;
     return out;
   }
   const double tau =
@@ -581,8 +653,13 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
       law.placement == DcrPlacement::Middle
           ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
           : touch;
-  out.separated = s * pair_volume(X_new) >= target ||
-                  dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift);
+  if (s * pair_volume(X_new) >= target) {
+    out.separated = true;
+    return out;
+  }
+  const PairPoints X_before = X_new;
+  out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift);
+  out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &out.impulse.applied);
   return out;
 }
 

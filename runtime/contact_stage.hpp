@@ -90,7 +90,7 @@ class ContactStage {
   /// while between searches x_old must be what this rank held as x_new at the end
   /// of the last step, as the time loop's x(n) is), and every node a pair moved
   /// gets its final state on every rank that touches it or holds it in its patch.
-  /// The result's contacts, dissipated and support_work are then this rank's part;
+  /// The result's contacts, dissipated, support_work and work are then this rank's part;
   /// when capped, unresolved is the first pair over all ranks (and its nodes' x_new
   /// are written here). rigid (null: none): the free rigid bodies (resolve_contacts); the
   /// result's rigid sums are this rank's part.

@@ -14,7 +14,8 @@ namespace shatter {
 /// the mid-step velocities (DcrResult::dissipated), >= 0 every step, so it never decreases.
 /// contact_work: the signed first-order energy the contact's changes dx of x(n+1) and dv
 /// of v(n+1/2) took out of the central-difference energy, sum f(n+1) . (dx - dt/2 dv)
-/// (docs/contact.md, "The ledger with e < 1"); > 0 when they removed energy.
+/// (docs/contact.md, "The ledger with e < 1"), plus the kinetic energy the projections'
+/// angular-momentum counterpart took out (DcrResult::work); > 0 when they removed energy.
 struct Ledger {
   double kinetic = 0, strain = 0, cohesive_stored = 0, cohesive_dissipated = 0, contact_dissipated = 0,
          contact_work = 0, external_work = 0;

@@ -259,6 +259,7 @@ void Simulation::resolve_contact() {
   }
   step_work_[kContactDissipated] += r.dissipated;
   step_work_[kSupportWork] += r.support_work;
+  step_work_[kContactWork] += r.work;
   step_work_[kContactsResolved] += static_cast<double>(r.contacts);
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)

@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <iomanip>
 #include <sstream>
@@ -350,9 +351,15 @@ TEST(DcrSweep, ElasticFrictionlessStackConservesMomentumAndEnergy) {
   EXPECT_GT(r.contacts, 0);
   EXPECT_EQ(r.dissipated.value(), 0.0);
   EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
-  EXPECT_CLOSE(after.kinetic, before.kinetic, 1e-13, 0);
+  EXPECT_LT((after.L - before.L).norm(), 1e-12 * before.L_scale);
+  // The kinetic energy: all but the projections' angular-momentum counterpart's work (booked
+  // as contact_work), 0.29 % of it here, where the projections move nodes by up to a tenth
+  // of an edge in one step.
+  EXPECT_CLOSE(before.kinetic - after.kinetic, r.work.value(), 0, 1e-13 * before.kinetic);
+  EXPECT_LT(std::abs(r.work.value()), 1e-2 * before.kinetic);
   RecordProperty("rel_linear_momentum_error", sci((after.p - before.p).norm() / before.p_scale));
-  RecordProperty("rel_kinetic_energy_error", sci(std::abs(after.kinetic / before.kinetic - 1)));
+  RecordProperty("rel_angular_momentum_error", sci((after.L - before.L).norm() / before.L_scale));
+  RecordProperty("rel_counterpart_work", sci(r.work.value() / before.kinetic));
 }
 
 TEST(DcrSweep, DissipationMatchesTheKineticEnergyLost) {
@@ -363,12 +370,46 @@ TEST(DcrSweep, DissipationMatchesTheKineticEnergyLost) {
   EXPECT_FALSE(r.capped);
   EXPECT_GT(r.dissipated.value(), 0);
   EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
-  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated.value(), 0, 1e-13 * before.kinetic);
+  EXPECT_LT((after.L - before.L).norm(), 1e-12 * before.L_scale);
+  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated.value() + r.work.value(), 0, 1e-13 * before.kinetic);
+}
+
+// Chains of pairs sharing nodes: the stacks collapse (thin sheets: a vertex pushed out of
+// one contact into the next, many rounds), sliding (the bodies' tangential velocities) and
+// spinning (a rigid spin of the whole stack about the origin added), every placement, with
+// and without friction and restitution. Linear and angular momentum of the free stack are
+// kept to 1e-12 of their scales at the state sum m x_new x v, and the kinetic energy lost is
+// the dissipation plus the projections' counterpart work.
+TEST(DcrSweep, CollapsingStacksKeepBothMomenta) {
+  for (const bool thin : {false, true})
+    for (const DcrPlacement placement : {DcrPlacement::End, DcrPlacement::Middle, DcrPlacement::Impact})
+      for (const auto& [e, mu] : {std::pair{1.0, 0.0}, std::pair{0.5, 0.3}}) {
+        SCOPED_TRACE(testing::Message() << "thin " << thin << ", placement " << static_cast<int>(placement) << ", e "
+                                        << e << ", mu " << mu);
+        Stack s = make_stack(5, 4, false, 11, thin);
+        const Vec3 omega(0.01, -0.02, 0.015);
+        for (size_t i = 0; i < s.v.size(); ++i) {
+          s.v[i] += omega.cross(s.x_old[i]);
+          s.x_new[i] = s.x_old[i] + s.v[i];
+        }
+        const Totals before = totals(s, s.x_new, s.v);
+        const DcrResult r = run(s, {e, mu, 1e-6, 200, placement});
+        const Totals after = totals(s, s.x_new, s.v);
+        EXPECT_FALSE(r.capped);
+        EXPECT_GT(r.contacts, 20);
+        EXPECT_LT((after.p - before.p).norm(), 1e-12 * before.p_scale);
+        EXPECT_LT((after.L - before.L).norm(), 1e-12 * before.L_scale);
+        EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated.value() + r.work.value(), 0,
+                     1e-13 * before.kinetic);
+        std::printf("thin %d placement %d e %.1f: %ld contacts, %d rounds, dL %.1e, work %.1e of K\n", thin,
+                    static_cast<int>(placement), e, static_cast<long>(r.contacts), r.sweeps,
+                    (after.L - before.L).norm() / before.L_scale, r.work.value() / before.kinetic);
+      }
 }
 
 TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
-  // Separate vertex-face impacts (no shared nodes): each resolved once, so the angular
-  // momentum about the origin, at the final positions, is unchanged to round-off.
+  // Separate vertex-face impacts (no shared nodes), sliding, with friction: the angular
+  // momentum about the origin of the state (x_new, v) is unchanged to round-off.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   Stack s;
@@ -387,14 +428,14 @@ TEST(DcrSweep, IndependentImpactsConserveAngularMomentum) {
     }
     s.pairs.push_back({ContactPair::VertexFace, {first, first + 1, first + 2, first + 3}});
   }
-  const std::vector<Vec3> v0 = s.v;
+  const Totals before = totals(s, s.x_new, s.v);
   const DcrResult r = run(s, {1.0, 0.5, 1e-6, 10});
   EXPECT_EQ(r.contacts, 50);
   EXPECT_EQ(r.sweeps, 2);
-  const Totals before = totals(s, s.x_new, v0), after = totals(s, s.x_new, s.v);
+  const Totals after = totals(s, s.x_new, s.v);
   EXPECT_LT((after.p - before.p).norm(), 1e-13 * before.p_scale);
   EXPECT_LT((after.L - before.L).norm(), 1e-13 * before.L_scale);
-  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated.value(), 0, 1e-13 * before.kinetic);
+  EXPECT_CLOSE(before.kinetic - after.kinetic, r.dissipated.value() + r.work.value(), 0, 1e-13 * before.kinetic);
   RecordProperty("rel_angular_momentum_error", sci((after.L - before.L).norm() / before.L_scale));
 }
 
