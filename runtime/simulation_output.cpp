@@ -178,7 +178,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("element_loop_time", element_seconds_);
   // element-steps per second per core spent in the element loop (the elements computed: not rigid bodies')
   j.add("element_updates_per_second",
-        element_seconds_ > 0 ? double(elements_.computed_elements()) * (step_ + 1) / (element_seconds_ * opt_.threads)
+        element_seconds_ > 0 ? double(elements_.computed_elements() + (shells_ ? shells_->elements() : 0)) * (step_ + 1) / (element_seconds_ * opt_.threads)
                              : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
   j.add("peak_memory_bytes_per_rank", memory.first);

@@ -1,0 +1,226 @@
+// Thin shells in the time loop (issue 17, docs/shells.md "The runtime"): a
+// spherical shell from a scene (bodies[i].shell), run by Simulation: its
+// lumped mass, momenta and energy while it spins and translates, its
+// breathing frequency against membrane theory, a held cap, a checkpoint and
+// the same bits for any thread count.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "expect_close.hpp"
+#include "mpi_environment.hpp"
+#include "runtime/checkpoint.hpp"
+#include "runtime/model.hpp"
+#include "runtime/simulation.hpp"
+#include "scene_text.hpp"
+
+using namespace shatter;
+using shatter::test::scene_from_text;
+
+namespace {
+
+constexpr double kYoung = 210.0e9, kPoisson = 0.3, kDensity = 7850;
+
+/// A steel spherical shell of radius R and thickness t, meshed at h; `body`
+/// lines are added to the body, `time` is the inside of time: {...}.
+std::string sphere_scene(const std::string& name, double R, double t, double h, const std::string& body,
+                         const std::string& time) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "name: " << name << "\ntime: {" << time << "}\n"
+     << "materials:\n  steel: {model: neo_hookean, density: " << kDensity << ", youngs_modulus: " << kYoung
+     << ", poisson_ratio: " << kPoisson << "}\n"
+     << "bodies:\n  - name: ball\n    material: steel\n    shell: {thickness: " << t << "}\n"
+     << "    mesh: {shape: sphere, radius: " << R << ", element_size: " << h << "}\n"
+     << body;
+  return os.str();
+}
+
+/// Linear and angular momentum of the model, from the positions and velocities.
+std::pair<Vec3, Vec3> momenta(const Model& m, const Simulation& sim) {
+  Vec3 P = Vec3::Zero(), L = Vec3::Zero();
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i) {
+    const Vec3 p = m.mass[i] * sim.velocities()[i];
+    P += p;
+    L += sim.positions()[i].cross(p);
+  }
+  return {P, L};
+}
+
+}  // namespace
+
+// The lumped masses add up to rho t A (A the reference limit surface's area,
+// partition of unity); the limit surface of a control net on the sphere lies
+// inside it (at this coarse mesh, 310 vertices, 4.8 % inside).
+TEST(ShellRuns, LumpedMassIsRhoTimesThicknessTimesArea) {
+  const double R = 0.12, t = 0.0035;
+  Model m = build_model(scene_from_text("shell_mass", sphere_scene("shell_mass", R, t, 0.03, "", "end: 1.0")));
+  ASSERT_EQ(m.shells.size(), 1u);
+  const ShellBody& s = m.shells[0];
+  EXPECT_EQ(m.mesh.num_elements(), 0);
+  EXPECT_EQ(s.first_node, 0);
+  EXPECT_EQ(m.mesh.num_nodes(), s.mesh.num_vertices());
+  double total = 0;
+  for (double mi : m.mass) {
+    EXPECT_GT(mi, 0.0);
+    total += mi;
+  }
+  EXPECT_CLOSE(total, kDensity * t * s.area, 1e-13, 0);
+  EXPECT_CLOSE(m.body_mass[0], total, 1e-13, 0);
+  const double R_limit = std::sqrt(s.area / (4 * std::numbers::pi));
+  EXPECT_LT(R_limit, R);
+  EXPECT_GT(R_limit, 0.94 * R);
+}
+
+// A free shell spinning at ~10 m/s on its equator and translating: linear and
+// angular momentum to round-off, and the ledger's total energy within 1e-6 of
+// the kinetic energy (docs/shells.md "Measured": the figure over 1e5 steps).
+TEST(ShellRuns, SpinningSphereKeepsMomentaAndEnergy) {
+  const double R = 0.12, t = 0.0035;
+  Model m = build_model(scene_from_text(
+      "shell_spin", sphere_scene("shell_spin", R, t, 0.03,
+                                 "    initial_velocity: [5, -2, 1]\n    angular_velocity: [0, 30, 80]\n",
+                                 "end: 1.0")));
+  Simulation sim(m, {});
+  const auto [P0, L0] = momenta(m, sim);
+  const double total0 = sim.ledger().total(), kinetic0 = sim.ledger().kinetic;
+  double worst = 0;
+  for (int n = 0; n < 3000; ++n) {
+    sim.step();
+    worst = std::max(worst, std::abs(sim.ledger().total() - total0));
+  }
+  const auto [P, L] = momenta(m, sim);
+  EXPECT_LT((P - P0).norm(), 1e-13 * P0.norm());
+  EXPECT_LT((L - L0).norm(), 1e-13 * L0.norm());
+  EXPECT_LT((sim.ledger().momentum - P0).norm(), 1e-13 * P0.norm());
+  EXPECT_GT(sim.ledger().strain, 0.0);  // the spin stretches it: the shell elements run
+  std::cout << "spinning shell: 3000 steps, dt " << sim.dt() << " s, |dP|/|P| " << (P - P0).norm() / P0.norm()
+            << ", |dL|/|L| " << (L - L0).norm() / L0.norm() << ", energy error " << worst / kinetic0
+            << " of the kinetic energy\n";
+  EXPECT_LT(worst, 1e-6 * kinetic0);
+}
+
+// Breathing mode of a free spherical shell from an initial radial velocity
+// (velocity_gradient = rate I): omega^2 = 2 E / (rho R^2 (1 - nu)) (membrane
+// theory; bending adds O(t^2/R^2)), R the limit surface's radius. The kinetic
+// energy (history.csv's column) has its minima twice per period.
+TEST(ShellRuns, BreathingFrequencyMatchesMembraneTheory) {
+  const double R = 1.0, t = 0.01;
+  Model m = build_model(scene_from_text(
+      "shell_breathe", sphere_scene("shell_breathe", R, t, 0.25,
+                                    "    velocity_gradient: [[1.0e-3, 0, 0], [0, 1.0e-3, 0], [0, 0, 1.0e-3]]\n",
+                                    "end: 1.0")));
+  const double R_limit = std::sqrt(m.shells[0].area / (4 * std::numbers::pi));
+  const double omega = std::sqrt(2 * kYoung / (kDensity * R_limit * R_limit * (1 - kPoisson)));
+  Simulation sim(m, {});
+  std::vector<double> minima;  // times of the kinetic energy's minima (parabola through three steps)
+  double k2 = sim.ledger().kinetic, k1 = k2, t1 = 0;
+  while (minima.size() < 5) {
+    sim.step();
+    const double k0 = sim.ledger().kinetic;
+    if (k1 < k2 && k1 <= k0 && sim.steps() > 2) {
+      const double dt = sim.time() - t1;  // steps of equal length here
+      minima.push_back(t1 + 0.5 * dt * (k2 - k0) / (k2 - 2 * k1 + k0));
+    }
+    k2 = k1, k1 = k0, t1 = sim.time();
+    ASSERT_LT(sim.time(), 20 * 2 * std::numbers::pi / omega);
+  }
+  const double period = 0.5 * (minima[4] - minima[0]);  // four half periods
+  const double measured = 2 * std::numbers::pi / period;
+  std::cout << "breathing shell: " << m.mesh.num_nodes() << " control vertices, omega " << measured
+            << " rad/s, membrane theory " << omega << " (R_limit " << R_limit << "), error "
+            << measured / omega - 1 << "\n";
+  EXPECT_CLOSE(measured, omega, 0.02, 0);
+}
+
+// A sphere whose bottom cap is held (a box region, all three components)
+// while the rest is thrown upward: the held vertices do not move, the free ones
+// do, and the ledger (reaction work included, 0 on a held support) keeps its
+// total within 1e-3 of the kinetic energy it started with: the sudden start
+// excites the highest modes, whose central-difference energy swings (measured
+// 1.6e-4; a wrong support or mass would be off by O(1)).
+TEST(ShellRuns, HeldCapKeepsTheLedger) {
+  Model m = build_model(scene_from_text(
+      "shell_held", sphere_scene("shell_held", 0.12, 0.0035, 0.03, "    initial_velocity: [0, 0, 2]\n"
+                                 "boundary_conditions:\n  - body: ball\n"
+                                 "    region: {box: [[-1, -1, -1], [1, 1, -0.1]]}\n    velocity: [0, 0, 0]\n",
+                                 "end: 1.0")));
+  std::vector<Index> held;
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i)
+    if (m.bc_mask[i] == 7) held.push_back(i);
+  ASSERT_GT(held.size(), 3u);
+  Simulation sim(m, {});
+  const double total0 = sim.ledger().total(), kinetic0 = sim.ledger().kinetic;
+  double worst = 0;
+  for (int n = 0; n < 500; ++n) {
+    sim.step();
+    worst = std::max(worst, std::abs(sim.ledger().total() - total0));
+  }
+  for (Index i : held) EXPECT_EQ(sim.positions()[i], m.mesh.reference[i]);
+  EXPECT_GT(sim.ledger().strain, 1e-3 * kinetic0);  // the cap pulls the shell back
+  std::cout << "held cap: 500 steps, strain " << sim.ledger().strain << " J, energy error " << worst / kinetic0
+            << " of the initial kinetic energy\n";
+  EXPECT_LT(worst, 1e-3 * kinetic0);
+}
+
+// A checkpoint of a shell run (its control vertices are the model's nodes)
+// continues bitwise as the run that never stopped.
+TEST(ShellRuns, RestoredRunIsBitwiseTheUninterruptedOne) {
+  const Scene scene = scene_from_text(
+      "shell_ckpt", sphere_scene("shell_ckpt", 0.12, 0.0035, 0.03,
+                                 "    initial_velocity: [3, -1, 2]\n    angular_velocity: [200, 500, -300]\n", "end: 1.0"));
+  Model whole_model = build_model(scene);
+  Simulation whole(whole_model, {});
+  for (int s = 0; s < 60; ++s) whole.step();
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shell_ckpt";
+  std::filesystem::create_directories(dir);
+  {
+    Model first_model = build_model(scene);
+    Simulation first(first_model, {});
+    for (int s = 0; s < 25; ++s) first.step();
+    SimulationState state;
+    first.save_state(state);
+    write_checkpoint(dir / "checkpoint.h5", first_model, state);
+  }
+  Model second_model = build_model(scene);
+  Simulation second(second_model, {});
+  second.restore_state(read_checkpoint(dir / "checkpoint.h5", second_model));
+  for (int s = 0; s < 35; ++s) second.step();
+  EXPECT_EQ(second.time(), whole.time());
+  EXPECT_EQ(second.ledger().total(), whole.ledger().total());
+  ASSERT_EQ(second.positions().size(), whole.positions().size());
+  EXPECT_EQ(0, std::memcmp(second.positions().data(), whole.positions().data(), whole.positions().size() * sizeof(Vec3)));
+  EXPECT_EQ(0,
+            std::memcmp(second.velocities().data(), whole.velocities().data(), whole.velocities().size() * sizeof(Vec3)));
+}
+
+// Same input, any thread count: the same bits (ShellForces sums each vertex's
+// patch slots in a fixed order).
+TEST(ShellRuns, BitwiseIdenticalForThreads124) {
+  std::vector<std::vector<Vec3>> results;
+  std::vector<double> energies;
+  for (int threads : {1, 2, 4}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    Model m = build_model(scene_from_text(
+        "shell_det", sphere_scene("shell_det", 0.12, 0.0035, 0.03,
+                                  "    initial_velocity: [3, -1, 2]\n"
+                                  "    velocity_gradient: [[300, 50, 0], [0, -200, 80], [10, 0, 100]]\n"
+                                  "    angular_velocity: [200, 500, -300]\n",
+                                  "end: 1.0")));
+    Simulation sim(m, {});
+    for (int s = 0; s < 100; ++s) sim.step();
+    results.emplace_back(sim.positions().begin(), sim.positions().end());
+    energies.push_back(sim.ledger().total());
+  }
+  for (size_t k = 1; k < results.size(); ++k) {
+    EXPECT_EQ(energies[k], energies[0]);
+    ASSERT_EQ(results[k].size(), results[0].size());
+    EXPECT_EQ(0, std::memcmp(results[k].data(), results[0].data(), results[0].size() * sizeof(Vec3)));
+  }
+}
