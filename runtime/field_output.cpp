@@ -116,6 +116,7 @@ struct FrameRecord {
   long long elements;
   bool fragment;
   bool damage;
+  long long triangles;  ///< shell triangles
 };
 
 std::string step_group_name(int step) {
@@ -154,23 +155,43 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
     const std::string step = step_group_name(f.step);
     const std::string n = std::to_string(f.nodes), e = std::to_string(f.elements);
     const int k = f.order == 1 ? 4 : 10;
-    os << "      <Grid Name=\"" << step.substr(1) << "\" GridType=\"Uniform\">\n"
-       << "        <Time Value=\"" << f.time << "\"/>\n"
-       << "        <Topology TopologyType=\"" << (f.order == 1 ? "Tetrahedron" : "Tetrahedron_10")
-       << "\" NumberOfElements=\"" << e << "\">\n";
-    data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
-    os << "        </Topology>\n"
-       << "        <Geometry GeometryType=\"XYZ\">\n";
-    data_item(os, n + " 3", "Float", 8, mesh + "/coordinates");
-    os << "        </Geometry>\n";
-    attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/displacement");
-    attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/velocity");
-    attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
-    attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
-    attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
-    if (f.fragment) attribute(os, "fragment", "Scalar", "Cell", e, "Int", 4, step + "/fragment");
-    if (f.damage) attribute(os, "damage", "Scalar", "Cell", e, "Float", 8, step + "/damage");
-    os << "      </Grid>\n";
+    auto geometry_and_motion = [&] {
+      os << "        <Geometry GeometryType=\"XYZ\">\n";
+      data_item(os, n + " 3", "Float", 8, mesh + "/coordinates");
+      os << "        </Geometry>\n";
+      attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/displacement");
+      attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/velocity");
+    };
+    const bool shells = f.triangles > 0;
+    if (shells)
+      os << "      <Grid Name=\"" << step.substr(1) << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+         << "        <Time Value=\"" << f.time << "\"/>\n";
+    if (!shells || f.elements > 0) {
+      os << "      <Grid Name=\"" << (shells ? std::string("solids") : step.substr(1)) << "\" GridType=\"Uniform\">\n";
+      if (!shells) os << "        <Time Value=\"" << f.time << "\"/>\n";
+      os << "        <Topology TopologyType=\"" << (f.order == 1 ? "Tetrahedron" : "Tetrahedron_10")
+         << "\" NumberOfElements=\"" << e << "\">\n";
+      data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
+      os << "        </Topology>\n";
+      geometry_and_motion();
+      attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
+      attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
+      attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
+      if (f.fragment) attribute(os, "fragment", "Scalar", "Cell", e, "Int", 4, step + "/fragment");
+      if (f.damage) attribute(os, "damage", "Scalar", "Cell", e, "Float", 8, step + "/damage");
+      os << "      </Grid>\n";
+    }
+    if (shells) {
+      const std::string t = std::to_string(f.triangles);
+      os << "      <Grid Name=\"shells\" GridType=\"Uniform\">\n"
+         << "        <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << t << "\">\n";
+      data_item(os, t + " 3", "Int", 8, mesh + "/shell_topology");
+      os << "        </Topology>\n";
+      geometry_and_motion();
+      attribute(os, "body", "Scalar", "Cell", t, "Int", 4, mesh + "/shell_body");
+      os << "      </Grid>\n";
+      os << "      </Grid>\n";
+    }
   }
   os << "    </Grid>\n"
      << "  </Domain>\n"
@@ -218,7 +239,7 @@ struct FieldWriter::State {
   int mesh_count = 0;  ///< mesh groups written so far
   std::uint64_t mesh_revision = 0;
   int mesh_order = 0;
-  long long mesh_nodes = -1, mesh_elements = -1;
+  long long mesh_nodes = -1, mesh_elements = -1, mesh_triangles = 0;
   std::vector<FrameRecord> frames;
 
   void write_frame(const Mesh& mesh, const FieldFrame& frame);
@@ -321,6 +342,7 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   expect_size("body", frame.body.size(), e);
   if (has[0]) expect_size("fragment", frame.fragment.size(), e);
   if (has[1]) expect_size("damage", frame.damage.size(), e);
+  expect_size("shell_body", frame.shell_body.size(), frame.shell_triangles.size());
   require_all(error.str(), s.comm);
 
   // Global placement: [0] nodes, [1] elements.
@@ -360,8 +382,19 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
     std::vector<std::int64_t> topology(mesh.conn.begin(), mesh.conn.end());
     if (order == 2)
       for (size_t i = 0; i < e; ++i) std::swap(topology[i * k + 8], topology[i * k + 9]);
-    write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(),
-               elem_rows, k);
+    // A model of shells alone has no element datasets (fields.xdmf names none).
+    if (total[1] > 0)
+      write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(), elem_rows, k);
+    if (!frame.shell_triangles.empty()) {
+      // One rank (shells are not cut into parts): its rows are all of them.
+      const hsize_t t = frame.shell_triangles.size();
+      const Rows triangle_rows{t, 0, t};
+      std::vector<std::int64_t> triangles;
+      for (const auto& c : frame.shell_triangles) triangles.insert(triangles.end(), c.begin(), c.end());
+      write_rows(group.get(), "shell_topology", H5T_NATIVE_INT64, H5T_STD_I64LE, triangles.data(), triangle_rows, 3);
+      write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.shell_body.data(), triangle_rows, 0);
+    }
+    s.mesh_triangles = static_cast<long long>(frame.shell_triangles.size());
     s.mesh_revision = mesh.revision;
     s.mesh_order = order;
     s.mesh_nodes = total[0];
@@ -390,22 +423,21 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   std::vector<double> stress(6 * e);
   for (size_t i = 0; i < e; ++i)
     for (int c = 0; c < 6; ++c) stress[6 * i + c] = frame.stress[6 * i + tensor6_from_voigt[c]];
-  write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
-  write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(),
-             elem_rows, 0);
-  write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);
-  if (has[0])
-    write_rows(group.get(), "fragment", H5T_NATIVE_INT, H5T_STD_I32LE, frame.fragment.data(),
-               elem_rows, 0);
-  if (has[1])
-    write_rows(group.get(), "damage", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.damage.data(),
-               elem_rows, 0);
+  if (total[1] > 0) {
+    write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
+    write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(), elem_rows, 0);
+    write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);
+    if (has[0])
+      write_rows(group.get(), "fragment", H5T_NATIVE_INT, H5T_STD_I32LE, frame.fragment.data(), elem_rows, 0);
+    if (has[1])
+      write_rows(group.get(), "damage", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.damage.data(), elem_rows, 0);
+  }
   group.reset();
   // The index may be opened while the run goes on: make the data it names durable first.
   check(H5Fflush(s.file.get(), H5F_SCOPE_GLOBAL), "flush fields.h5");
 
   s.frames.push_back(FrameRecord{frame.step, frame.time, mesh_index, s.mesh_order, total[0],
-                                 total[1], has[0] != 0, has[1] != 0});
+                                 total[1], has[0] != 0, has[1] != 0, s.mesh_triangles});
   s.write_xdmf();
 }
 

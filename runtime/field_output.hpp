@@ -18,6 +18,13 @@
 //       body                e int32
 //       fragment            e int32 (only when fracture is on)
 //       damage              e float64 (only when given)
+//   /mesh/<k>/shell_topology  s x 3 int64, node rows of the shells' control
+//                           triangles (only with shells, FieldFrame::shell_triangles)
+//   /mesh/<k>/shell_body    s int32, the body of each shell triangle
+// With shells each frame is a spatial collection of two grids, "solids" (the
+// tetrahedra, left out when there are none) and "shells" (the control
+// triangles: the mid-surface's control net, with the nodes' displacement and
+// velocity).
 // A mesh group k = 0, 1, ... is written for the first frame and again for
 // every frame whose mesh topology changed (fracture splits nodes).
 //
@@ -29,6 +36,7 @@
 // ParaView GUI labels in VTK's order (XX YY ZZ XY YZ XZ).
 #include <mpi.h>
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <span>
@@ -54,6 +62,10 @@ struct FieldFrame {
   std::span<const int> fragment;
   /// [e] per element, damage in [0, 1]; optional (empty = not written).
   std::span<const double> damage;
+  /// [s] shell control triangles in node rows, and their bodies (on one rank
+  /// only: shells are not cut into parts); empty without shells.
+  std::span<const std::array<Index, 3>> shell_triangles;
+  std::span<const int> shell_body;
 };
 
 /// Writes fields.h5 and its XDMF index fields.xdmf into one directory.

@@ -130,6 +130,16 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   f.body = body;
   f.fragment = fragment;
   f.damage = block_damage;
+  // The shells' control triangles in node rows (one rank: the local ids).
+  std::vector<std::array<Index, 3>> shell_triangles;
+  std::vector<int> shell_body;
+  for (const ShellBody& sb : model_.shells)
+    for (const auto& t : sb.mesh.triangles) {
+      shell_triangles.push_back({sb.first_node + t[0], sb.first_node + t[1], sb.first_node + t[2]});
+      shell_body.push_back(sb.body);
+    }
+  f.shell_triangles = shell_triangles;
+  f.shell_body = shell_body;
   fields_->write(block, f);
 }
 

@@ -1,9 +1,10 @@
 // Thin shells in the time loop (issue 17, docs/shells.md "The runtime"): a
 // spherical shell from a scene (bodies[i].shell), run by Simulation: its
 // lumped mass, momenta and energy while it spins and translates, its
-// breathing frequency against membrane theory, a held cap, a checkpoint and
-// the same bits for any thread count.
+// breathing frequency against membrane theory, a held cap, a checkpoint, the
+// same bits for any thread count, and its mid-surface in fields.h5/xdmf.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
@@ -223,4 +224,44 @@ TEST(ShellRuns, BitwiseIdenticalForThreads124) {
     ASSERT_EQ(results[k].size(), results[0].size());
     EXPECT_EQ(0, std::memcmp(results[k].data(), results[0].data(), results[0].size() * sizeof(Vec3)));
   }
+}
+
+// fields.h5 holds the shells' control triangles and the nodes' displacement;
+// fields.xdmf names them as a Triangle grid.
+TEST(ShellRuns, FieldsHoldTheMidSurface) {
+  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shell_fields";
+  std::filesystem::remove_all(dir);
+  Model m = build_model(scene_from_text(
+      "shell_fields", sphere_scene("shell_fields", 0.12, 0.0035, 0.03,
+                                   "    initial_velocity: [5, 0, 0]\noutput: {every: 10}\n", "end: 2.0e-6, dt: 1.0e-7")));
+  RunOptions opt;
+  opt.out_dir = dir;
+  opt.quiet = true;
+  {
+    Simulation sim(m, opt);
+    sim.run();
+  }
+  std::ifstream in(dir / "fields.xdmf");
+  const std::string xdmf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(xdmf.find("TopologyType=\"Triangle\""), std::string::npos);
+  EXPECT_EQ(xdmf.find("Tetrahedron"), std::string::npos);  // no solids: no empty grid
+  const hid_t file = H5Fopen((dir / "fields.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t set = H5Dopen2(file, "/mesh/0/shell_topology", H5P_DEFAULT);
+  ASSERT_GE(set, 0);
+  const hid_t space = H5Dget_space(set);
+  hsize_t dims[2] = {0, 0};
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  EXPECT_EQ(dims[0], static_cast<hsize_t>(m.shells[0].mesh.num_triangles()));
+  EXPECT_EQ(dims[1], 3u);
+  H5Sclose(space);
+  H5Dclose(set);
+  // The last frame's displacement: the translation, 5 m/s x its time, on every node.
+  const hid_t disp = H5Dopen2(file, "/step_000010/displacement", H5P_DEFAULT);
+  ASSERT_GE(disp, 0);
+  std::vector<double> u(3 * m.mesh.num_nodes());
+  H5Dread(disp, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, u.data());
+  H5Dclose(disp);
+  H5Fclose(file);
+  for (Index i = 0; i < m.mesh.num_nodes(); ++i) EXPECT_GT(u[3 * i], 0.0);
 }
