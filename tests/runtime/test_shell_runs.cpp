@@ -5,7 +5,6 @@
 // same bits for any thread count, and its mid-surface in fields.h5/xdmf.
 #include <gtest/gtest.h>
 #include <hdf5.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstring>
@@ -13,9 +12,11 @@
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "expect_close.hpp"
 #include "mpi_environment.hpp"
+#include "run_checks.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
@@ -43,6 +44,11 @@ std::string sphere_scene(const std::string& name, double R, double t, double h, 
   return os.str();
 }
 
+/// The model of sphere_scene(name, R, t, h, body) with time.end = 1 s (runs step by step).
+Model sphere_model(const std::string& name, double R, double t, double h, const std::string& body) {
+  return build_model(scene_from_text(name, sphere_scene(name, R, t, h, body, "end: 1.0")));
+}
+
 /// Linear and angular momentum of the model, from the positions and velocities.
 std::pair<Vec3, Vec3> momenta(const Model& m, const Simulation& sim) {
   Vec3 P = Vec3::Zero(), L = Vec3::Zero();
@@ -54,6 +60,25 @@ std::pair<Vec3, Vec3> momenta(const Model& m, const Simulation& sim) {
   return {P, L};
 }
 
+/// What `steps` steps of a free run keep: the momenta before and after, the
+/// largest |total - total(0)| over the steps and the kinetic energy at the start.
+struct FreeRun {
+  Vec3 P0, L0, P, L;
+  double worst = 0, kinetic0 = 0;
+};
+FreeRun run_free(const Model& m, Simulation& sim, int steps) {
+  FreeRun r;
+  std::tie(r.P0, r.L0) = momenta(m, sim);
+  const double total0 = sim.ledger().total();
+  r.kinetic0 = sim.ledger().kinetic;
+  for (int n = 0; n < steps; ++n) {
+    sim.step();
+    r.worst = std::max(r.worst, std::abs(sim.ledger().total() - total0));
+  }
+  std::tie(r.P, r.L) = momenta(m, sim);
+  return r;
+}
+
 }  // namespace
 
 // The lumped masses add up to rho t A (A the reference limit surface's area,
@@ -61,7 +86,7 @@ std::pair<Vec3, Vec3> momenta(const Model& m, const Simulation& sim) {
 // inside it (at this coarse mesh, 310 vertices, 4.8 % inside).
 TEST(ShellRuns, LumpedMassIsRhoTimesThicknessTimesArea) {
   const double R = 0.12, t = 0.0035;
-  Model m = build_model(scene_from_text("shell_mass", sphere_scene("shell_mass", R, t, 0.03, "", "end: 1.0")));
+  Model m = sphere_model("shell_mass", R, t, 0.03, "");
   ASSERT_EQ(m.shells.size(), 1u);
   const ShellBody& s = m.shells[0];
   EXPECT_EQ(m.mesh.num_elements(), 0);
@@ -84,27 +109,17 @@ TEST(ShellRuns, LumpedMassIsRhoTimesThicknessTimesArea) {
 // the kinetic energy (docs/shells.md "Measured": the figure over 1e5 steps).
 TEST(ShellRuns, SpinningSphereKeepsMomentaAndEnergy) {
   const double R = 0.12, t = 0.0035;
-  Model m = build_model(scene_from_text(
-      "shell_spin", sphere_scene("shell_spin", R, t, 0.03,
-                                 "    initial_velocity: [5, -2, 1]\n    angular_velocity: [0, 30, 80]\n",
-                                 "end: 1.0")));
+  Model m = sphere_model("shell_spin", R, t, 0.03, "    initial_velocity: [5, -2, 1]\n    angular_velocity: [0, 30, 80]\n");
   Simulation sim(m, {});
-  const auto [P0, L0] = momenta(m, sim);
-  const double total0 = sim.ledger().total(), kinetic0 = sim.ledger().kinetic;
-  double worst = 0;
-  for (int n = 0; n < 3000; ++n) {
-    sim.step();
-    worst = std::max(worst, std::abs(sim.ledger().total() - total0));
-  }
-  const auto [P, L] = momenta(m, sim);
-  EXPECT_LT((P - P0).norm(), 1e-13 * P0.norm());
-  EXPECT_LT((L - L0).norm(), 1e-13 * L0.norm());
-  EXPECT_LT((sim.ledger().momentum - P0).norm(), 1e-13 * P0.norm());
+  const FreeRun r = run_free(m, sim, 3000);
+  EXPECT_LT((r.P - r.P0).norm(), 1e-13 * r.P0.norm());
+  EXPECT_LT((r.L - r.L0).norm(), 1e-13 * r.L0.norm());
+  EXPECT_LT((sim.ledger().momentum - r.P0).norm(), 1e-13 * r.P0.norm());
   EXPECT_GT(sim.ledger().strain, 0.0);  // the spin stretches it: the shell elements run
-  std::cout << "spinning shell: 3000 steps, dt " << sim.dt() << " s, |dP|/|P| " << (P - P0).norm() / P0.norm()
-            << ", |dL|/|L| " << (L - L0).norm() / L0.norm() << ", energy error " << worst / kinetic0
+  std::cout << "spinning shell: 3000 steps, dt " << sim.dt() << " s, |dP|/|P| " << (r.P - r.P0).norm() / r.P0.norm()
+            << ", |dL|/|L| " << (r.L - r.L0).norm() / r.L0.norm() << ", energy error " << r.worst / r.kinetic0
             << " of the kinetic energy\n";
-  EXPECT_LT(worst, 1e-6 * kinetic0);
+  EXPECT_LT(r.worst, 1e-6 * r.kinetic0);
 }
 
 // Breathing mode of a free spherical shell from an initial radial velocity
@@ -113,10 +128,8 @@ TEST(ShellRuns, SpinningSphereKeepsMomentaAndEnergy) {
 // energy (history.csv's column) has its minima twice per period.
 TEST(ShellRuns, BreathingFrequencyMatchesMembraneTheory) {
   const double R = 1.0, t = 0.01;
-  Model m = build_model(scene_from_text(
-      "shell_breathe", sphere_scene("shell_breathe", R, t, 0.25,
-                                    "    velocity_gradient: [[1.0e-3, 0, 0], [0, 1.0e-3, 0], [0, 0, 1.0e-3]]\n",
-                                    "end: 1.0")));
+  Model m = sphere_model("shell_breathe", R, t, 0.25,
+                         "    velocity_gradient: [[1.0e-3, 0, 0], [0, 1.0e-3, 0], [0, 0, 1.0e-3]]\n");
   const double R_limit = std::sqrt(m.shells[0].area / (4 * std::numbers::pi));
   const double omega = std::sqrt(2 * kYoung / (kDensity * R_limit * R_limit * (1 - kPoisson)));
   Simulation sim(m, {});
@@ -147,27 +160,20 @@ TEST(ShellRuns, BreathingFrequencyMatchesMembraneTheory) {
 // excites the highest modes, whose central-difference energy swings (measured
 // 1.6e-4; a wrong support or mass would be off by O(1)).
 TEST(ShellRuns, HeldCapKeepsTheLedger) {
-  Model m = build_model(scene_from_text(
-      "shell_held", sphere_scene("shell_held", 0.12, 0.0035, 0.03, "    initial_velocity: [0, 0, 2]\n"
-                                 "boundary_conditions:\n  - body: ball\n"
-                                 "    region: {box: [[-1, -1, -1], [1, 1, -0.1]]}\n    velocity: [0, 0, 0]\n",
-                                 "end: 1.0")));
+  Model m = sphere_model("shell_held", 0.12, 0.0035, 0.03,
+                         "    initial_velocity: [0, 0, 2]\nboundary_conditions:\n  - body: ball\n"
+                         "    region: {box: [[-1, -1, -1], [1, 1, -0.1]]}\n    velocity: [0, 0, 0]\n");
   std::vector<Index> held;
   for (Index i = 0; i < m.mesh.num_nodes(); ++i)
     if (m.bc_mask[i] == 7) held.push_back(i);
   ASSERT_GT(held.size(), 3u);
   Simulation sim(m, {});
-  const double total0 = sim.ledger().total(), kinetic0 = sim.ledger().kinetic;
-  double worst = 0;
-  for (int n = 0; n < 500; ++n) {
-    sim.step();
-    worst = std::max(worst, std::abs(sim.ledger().total() - total0));
-  }
+  const FreeRun r = run_free(m, sim, 500);
   for (Index i : held) EXPECT_EQ(sim.positions()[i], m.mesh.reference[i]);
-  EXPECT_GT(sim.ledger().strain, 1e-3 * kinetic0);  // the cap pulls the shell back
-  std::cout << "held cap: 500 steps, strain " << sim.ledger().strain << " J, energy error " << worst / kinetic0
+  EXPECT_GT(sim.ledger().strain, 1e-3 * r.kinetic0);  // the cap pulls the shell back
+  std::cout << "held cap: 500 steps, strain " << sim.ledger().strain << " J, energy error " << r.worst / r.kinetic0
             << " of the initial kinetic energy\n";
-  EXPECT_LT(worst, 1e-3 * kinetic0);
+  EXPECT_LT(r.worst, 1e-3 * r.kinetic0);
 }
 
 // An open shell (a cylinder's side: its two circular edges free, their
@@ -186,18 +192,11 @@ TEST(ShellRuns, FreeCylinderKeepsMomentaAndEnergy) {
   Model m = build_model(scene_from_text("shell_cylinder", yaml.str()));
   ASSERT_GT(m.shells[0].mesh.ghost_rule.size(), 0u);  // the free edges' ghosts are in use
   Simulation sim(m, {});
-  const auto [P0, L0] = momenta(m, sim);
-  const double total0 = sim.ledger().total(), kinetic0 = sim.ledger().kinetic;
-  double worst = 0;
-  for (int n = 0; n < 600; ++n) {
-    sim.step();
-    worst = std::max(worst, std::abs(sim.ledger().total() - total0));
-  }
-  const auto [P, L] = momenta(m, sim);
-  EXPECT_LT((P - P0).norm(), 1e-13 * P0.norm());
-  EXPECT_LT((L - L0).norm(), 1e-13 * L0.norm());
-  EXPECT_GT(sim.ledger().strain, 1e-3 * kinetic0);
-  EXPECT_LT(worst, 1e-3 * kinetic0);
+  const FreeRun r = run_free(m, sim, 600);
+  EXPECT_LT((r.P - r.P0).norm(), 1e-13 * r.P0.norm());
+  EXPECT_LT((r.L - r.L0).norm(), 1e-13 * r.L0.norm());
+  EXPECT_GT(sim.ledger().strain, 1e-3 * r.kinetic0);
+  EXPECT_LT(r.worst, 1e-3 * r.kinetic0);
 }
 
 // A checkpoint of a shell run (its control vertices are the model's nodes)
@@ -234,26 +233,13 @@ TEST(ShellRuns, RestoredRunIsBitwiseTheUninterruptedOne) {
 // Same input, any thread count: the same bits (ShellForces sums each vertex's
 // patch slots in a fixed order).
 TEST(ShellRuns, BitwiseIdenticalForThreads124) {
-  std::vector<std::vector<Vec3>> results;
-  std::vector<double> energies;
-  for (int threads : {1, 2, 4}) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    Model m = build_model(scene_from_text(
-        "shell_det", sphere_scene("shell_det", 0.12, 0.0035, 0.03,
-                                  "    initial_velocity: [3, -1, 2]\n"
-                                  "    velocity_gradient: [[300, 50, 0], [0, -200, 80], [10, 0, 100]]\n"
-                                  "    angular_velocity: [200, 500, -300]\n",
-                                  "end: 1.0")));
-    Simulation sim(m, {});
-    for (int s = 0; s < 100; ++s) sim.step();
-    results.emplace_back(sim.positions().begin(), sim.positions().end());
-    energies.push_back(sim.ledger().total());
-  }
-  for (size_t k = 1; k < results.size(); ++k) {
-    EXPECT_EQ(energies[k], energies[0]);
-    ASSERT_EQ(results[k].size(), results[0].size());
-    EXPECT_EQ(0, std::memcmp(results[k].data(), results[0].data(), results[0].size() * sizeof(Vec3)));
-  }
+  shatter::test::expect_same_bits_for_threads(
+      scene_from_text("shell_det", sphere_scene("shell_det", 0.12, 0.0035, 0.03,
+                                                "    initial_velocity: [3, -1, 2]\n"
+                                                "    velocity_gradient: [[300, 50, 0], [0, -200, 80], [10, 0, 100]]\n"
+                                                "    angular_velocity: [200, 500, -300]\n",
+                                                "end: 1.0")),
+      100);
 }
 
 // fields.h5 holds the shells' control triangles and the nodes' displacement;
