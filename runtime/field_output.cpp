@@ -116,7 +116,8 @@ struct FrameRecord {
   long long elements;
   bool fragment;
   bool damage;
-  long long triangles;  ///< shell triangles
+  long long triangles;       ///< shell triangles
+  long long shell_vertices;  ///< shell control vertices
 };
 
 std::string step_group_name(int step) {
@@ -155,12 +156,13 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
     const std::string step = step_group_name(f.step);
     const std::string n = std::to_string(f.nodes), e = std::to_string(f.elements);
     const int k = f.order == 1 ? 4 : 10;
-    auto geometry_and_motion = [&] {
+    // The points (n of them, named prefix + coordinates etc.) with their displacement and velocity.
+    auto geometry_and_motion = [&](const std::string& n, const std::string& prefix) {
       os << "        <Geometry GeometryType=\"XYZ\">\n";
-      data_item(os, n + " 3", "Float", 8, mesh + "/coordinates");
+      data_item(os, n + " 3", "Float", 8, mesh + "/" + prefix + "coordinates");
       os << "        </Geometry>\n";
-      attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/displacement");
-      attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/velocity");
+      attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/" + prefix + "displacement");
+      attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/" + prefix + "velocity");
     };
     const bool shells = f.triangles > 0;
     if (shells)
@@ -173,7 +175,7 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
          << "\" NumberOfElements=\"" << e << "\">\n";
       data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
       os << "        </Topology>\n";
-      geometry_and_motion();
+      geometry_and_motion(n, "");
       attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
       attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
       attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
@@ -187,7 +189,7 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
          << "        <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << t << "\">\n";
       data_item(os, t + " 3", "Int", 8, mesh + "/shell_topology");
       os << "        </Topology>\n";
-      geometry_and_motion();
+      geometry_and_motion(std::to_string(f.shell_vertices), "shell_");
       attribute(os, "body", "Scalar", "Cell", t, "Int", 4, mesh + "/shell_body");
       os << "      </Grid>\n";
       os << "      </Grid>\n";
@@ -239,7 +241,7 @@ struct FieldWriter::State {
   int mesh_count = 0;  ///< mesh groups written so far
   std::uint64_t mesh_revision = 0;
   int mesh_order = 0;
-  long long mesh_nodes = -1, mesh_elements = -1, mesh_triangles = 0;
+  long long mesh_nodes = -1, mesh_elements = -1, mesh_triangles = 0, mesh_shell_vertices = 0;
   std::vector<FrameRecord> frames;
 
   void write_frame(const Mesh& mesh, const FieldFrame& frame);
@@ -343,6 +345,8 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   if (has[0]) expect_size("fragment", frame.fragment.size(), e);
   if (has[1]) expect_size("damage", frame.damage.size(), e);
   expect_size("shell_body", frame.shell_body.size(), frame.shell_triangles.size());
+  expect_size("shell_displacement", frame.shell_displacement.size(), frame.shell_reference.size());
+  expect_size("shell_velocity", frame.shell_velocity.size(), frame.shell_reference.size());
   require_all(error.str(), s.comm);
 
   // Global placement: [0] nodes, [1] elements.
@@ -387,14 +391,17 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
       write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(), elem_rows, k);
     if (!frame.shell_triangles.empty()) {
       // One rank (shells are not cut into parts): its rows are all of them.
-      const hsize_t t = frame.shell_triangles.size();
-      const Rows triangle_rows{t, 0, t};
+      const hsize_t t = frame.shell_triangles.size(), v = frame.shell_reference.size();
+      const Rows triangle_rows{t, 0, t}, vertex_rows{v, 0, v};
       std::vector<std::int64_t> triangles;
       for (const auto& c : frame.shell_triangles) triangles.insert(triangles.end(), c.begin(), c.end());
+      write_rows(group.get(), "shell_coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_reference.data(),
+                 vertex_rows, 3);
       write_rows(group.get(), "shell_topology", H5T_NATIVE_INT64, H5T_STD_I64LE, triangles.data(), triangle_rows, 3);
       write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.shell_body.data(), triangle_rows, 0);
     }
     s.mesh_triangles = static_cast<long long>(frame.shell_triangles.size());
+    s.mesh_shell_vertices = static_cast<long long>(frame.shell_reference.size());
     s.mesh_revision = mesh.revision;
     s.mesh_order = order;
     s.mesh_nodes = total[0];
@@ -423,6 +430,14 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   std::vector<double> stress(6 * e);
   for (size_t i = 0; i < e; ++i)
     for (int c = 0; c < 6; ++c) stress[6 * i + c] = frame.stress[6 * i + tensor6_from_voigt[c]];
+  if (!frame.shell_triangles.empty()) {
+    const hsize_t v = frame.shell_displacement.size();
+    const Rows vertex_rows{v, 0, v};
+    write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_displacement.data(),
+               vertex_rows, 3);
+    write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_velocity.data(),
+               vertex_rows, 3);
+  }
   if (total[1] > 0) {
     write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
     write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(), elem_rows, 0);
@@ -437,7 +452,7 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   check(H5Fflush(s.file.get(), H5F_SCOPE_GLOBAL), "flush fields.h5");
 
   s.frames.push_back(FrameRecord{frame.step, frame.time, mesh_index, s.mesh_order, total[0],
-                                 total[1], has[0] != 0, has[1] != 0, s.mesh_triangles});
+                                 total[1], has[0] != 0, has[1] != 0, s.mesh_triangles, s.mesh_shell_vertices});
   s.write_xdmf();
 }
 

@@ -18,13 +18,16 @@
 //       body                e int32
 //       fragment            e int32 (only when fracture is on)
 //       damage              e float64 (only when given)
-//   /mesh/<k>/shell_topology  s x 3 int64, node rows of the shells' control
-//                           triangles (only with shells, FieldFrame::shell_triangles)
+// With shells (v control vertices, s triangles; FieldFrame::shell_*):
+//   /mesh/<k>/shell_coordinates  v x 3 float64, the reference limit surface at
+//                           the control vertices, m
+//   /mesh/<k>/shell_topology  s x 3 int64, rows of shell_coordinates
 //   /mesh/<k>/shell_body    s int32, the body of each shell triangle
-// With shells each frame is a spatial collection of two grids, "solids" (the
-// tetrahedra, left out when there are none) and "shells" (the control
-// triangles: the mid-surface's control net, with the nodes' displacement and
-// velocity).
+//   /step_<NNNNNN>/shell_displacement, shell_velocity  v x 3 float64, of the
+//                           limit surface at the control vertices, m and m/s
+// and each frame is a spatial collection of two grids, "solids" (the
+// tetrahedra, left out when there are none) and "shells" (the mid-surface:
+// the control triangles with their corners on the limit surface).
 // A mesh group k = 0, 1, ... is written for the first frame and again for
 // every frame whose mesh topology changed (fracture splits nodes).
 //
@@ -62,10 +65,13 @@ struct FieldFrame {
   std::span<const int> fragment;
   /// [e] per element, damage in [0, 1]; optional (empty = not written).
   std::span<const double> damage;
-  /// [s] shell control triangles in node rows, and their bodies (on one rank
-  /// only: shells are not cut into parts); empty without shells.
+  /// Shells (on one rank only: shells are not cut into parts; empty without
+  /// them): [s] control triangles in rows of the [v] shell vertices, and
+  /// their bodies; per shell vertex its reference limit point (m), and the
+  /// limit surface's displacement (m) and velocity (m/s) there.
   std::span<const std::array<Index, 3>> shell_triangles;
   std::span<const int> shell_body;
+  std::span<const Vec3> shell_reference, shell_displacement, shell_velocity;
 };
 
 /// Writes fields.h5 and its XDMF index fields.xdmf into one directory.

@@ -1,5 +1,6 @@
 #include "runtime/shell_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -86,7 +87,74 @@ ShellBody build_shell_body(const Scene& scene, int body, const std::string& wher
     with_valence(n, [&](auto N) { add_references<N()>(s, set); });
   }
   number_slots(s);
+  shell_limit_stencils(s);
   return s;
+}
+
+std::vector<std::pair<Index, double>> shell_corner_stencil(const ShellBody& s, Index t, int c) {
+  constexpr double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  const Index n = s.mesh.patch_size(t) - 6;
+  std::vector<std::pair<Index, double>> out;
+  if (n != 6 && c == 0) return out;  // the extraordinary corner: no regular sub-triangle holds it
+  const Index* entries = s.mesh.patch_of(t);
+  with_valence(static_cast<int>(n), [&](auto N) {
+    Eigen::Matrix<double, N() + 6, 1> basis;
+    if constexpr (N() == 6) basis = loop_regular_basis(corner[c][0], corner[c][1]).N;
+    else basis = loop_extraordinary_basis<N()>(corner[c][0], corner[c][1]).N;
+    for (int a = 0; a < N() + 6; ++a)
+      if (basis[a] != 0) out.emplace_back(entries[a], basis[a]);
+  });
+  return out;
+}
+
+void shell_limit_stencils(ShellBody& s) {
+  const Index nv = s.mesh.num_vertices();
+  // Per vertex: a triangle and corner it is a regular corner of, or an extraordinary patch it is the corner of.
+  std::vector<std::pair<Index, int>> regular(nv, {-1, -1});
+  std::vector<Index> extraordinary(nv, -1);
+  for (Index t = 0; t < s.mesh.num_triangles(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const Index v = s.mesh.triangles[t][c];
+      if (s.mesh.patch_size(t) != 12 && c == 0) {
+        if (extraordinary[v] < 0) extraordinary[v] = t;
+      } else if (regular[v].first < 0) {
+        regular[v] = {t, c};
+      }
+    }
+  s.limit_offsets.assign(1, 0);
+  s.limit_vertex.clear();
+  s.limit_weight.clear();
+  s.limit_reference.assign(nv, Vec3::Zero());
+  std::vector<double> weight(nv, 0.0);
+  std::vector<char> seen(nv, 0);
+  std::vector<Index> touched;
+  for (Index v = 0; v < nv; ++v) {
+    std::vector<std::pair<Index, double>> stencil;
+    if (regular[v].first >= 0) {
+      stencil = shell_corner_stencil(s, regular[v].first, regular[v].second);
+    } else {
+      const Index t = extraordinary[v];
+      const Index n = s.mesh.patch_size(t) - 6;
+      const double c = 3.0 / 8 + 0.25 * std::cos(2 * std::numbers::pi / n);
+      const double beta = (5.0 / 8 - c * c) / n, chi = 1.0 / (n + 3.0 / (8 * beta));
+      stencil.emplace_back(s.mesh.patch_of(t)[0], 1 - n * chi);
+      for (Index k = 1; k <= n; ++k) stencil.emplace_back(s.mesh.patch_of(t)[k], chi);
+    }
+    for (const auto& [entry, w] : stencil) {
+      s.limit_reference[v] += w * s.mesh.entry_position(s.mesh.reference, entry);
+      s.mesh.scatter_entry(entry, [&](Index u, double g) {
+        if (!seen[u]) seen[u] = 1, touched.push_back(u);
+        weight[u] += g * w;
+      });
+    }
+    std::sort(touched.begin(), touched.end());
+    for (const Index u : touched) {
+      if (weight[u] != 0) s.limit_vertex.push_back(u), s.limit_weight.push_back(weight[u]);
+      weight[u] = 0, seen[u] = 0;
+    }
+    touched.clear();
+    s.limit_offsets.push_back(static_cast<Index>(s.limit_vertex.size()));
+  }
 }
 
 double estimated_shell_triangles(const ShellShapeSpec& s) {

@@ -82,6 +82,13 @@ struct ShellBody {
   std::vector<Index> vertex_slot_offsets, vertex_slot;
   std::vector<double> vertex_slot_weight;
   double area = 0;  ///< of the reference limit surface, m^2 (sum of the quadrature weights)
+  /// The limit surface at the vertices (shell_limit_stencils): CSR per vertex
+  /// v, the vertices u and weights W with limit point sum_u W x_u + a constant
+  /// (even ghosts' offsets), so that the limit displacement and velocity are
+  /// sum_u W u_u and sum_u W v_u; limit_reference[v]: the reference limit point, m.
+  std::vector<Index> limit_offsets, limit_vertex;
+  std::vector<double> limit_weight;
+  std::vector<Vec3> limit_reference;
 };
 
 /// The shell body `body` of `scene`: its mid-surface meshed by Gmsh at twice
@@ -92,6 +99,20 @@ struct ShellBody {
 /// and unstructured boundaries that docs/shells.md lists as missing) or a
 /// corner's valence is outside [kShellMinValence, kShellMaxValence].
 ShellBody build_shell_body(const Scene& scene, int body, const std::string& where);
+
+/// Fills the limit stencils of `shell` (ShellBody::limit_offsets ...): a
+/// vertex that is a regular corner of a patch (a corner of valence 6, or a
+/// non-extraordinary corner of an extraordinary patch) gets the patch's basis
+/// at that corner, of its first triangle with one; an extraordinary vertex
+/// in the interior Loop's limit mask (1 - N chi) x + chi sum of its ring,
+/// chi = 1 / (N + 3 / (8 beta)) (Loop 1987; Hoppe et al., SIGGRAPH 1994).
+void shell_limit_stencils(ShellBody& shell);
+
+/// The limit point of control vertex v from patch entries: the basis of the
+/// patch of triangle t at its corner c (0, 1, 2: triangles[t][c]), as
+/// (patch entry, weight) pairs; empty when that corner is the extraordinary
+/// one of the patch.
+std::vector<std::pair<Index, double>> shell_corner_stencil(const ShellBody& shell, Index t, int c);
 
 /// About how many control triangles build_shell_body makes of a mid-surface:
 /// its area over that of an equilateral triangle of edge element_size.

@@ -130,16 +130,34 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   f.body = body;
   f.fragment = fragment;
   f.damage = block_damage;
-  // The shells' control triangles in node rows (one rank: the local ids).
+  // The shells' mid-surface (one rank): the control triangles, their corners
+  // on the limit surface (ShellBody::limit_*), body after body.
   std::vector<std::array<Index, 3>> shell_triangles;
   std::vector<int> shell_body;
-  for (const ShellBody& sb : model_.shells)
+  std::vector<Vec3> shell_reference, shell_u, shell_v;
+  for (const ShellBody& sb : model_.shells) {
+    const Index row0 = static_cast<Index>(shell_reference.size());
     for (const auto& t : sb.mesh.triangles) {
-      shell_triangles.push_back({sb.first_node + t[0], sb.first_node + t[1], sb.first_node + t[2]});
+      shell_triangles.push_back({row0 + t[0], row0 + t[1], row0 + t[2]});
       shell_body.push_back(sb.body);
     }
+    for (Index p = 0; p < sb.mesh.num_vertices(); ++p) {
+      Vec3 du = Vec3::Zero(), dv = Vec3::Zero();
+      for (Index k = sb.limit_offsets[p]; k < sb.limit_offsets[p + 1]; ++k) {
+        const Index i = sb.first_node + sb.limit_vertex[k];
+        du += sb.limit_weight[k] * (x_[i] - mesh.reference[i]);
+        dv += sb.limit_weight[k] * v_[i];
+      }
+      shell_reference.push_back(sb.limit_reference[p]);
+      shell_u.push_back(du);
+      shell_v.push_back(dv);
+    }
+  }
   f.shell_triangles = shell_triangles;
   f.shell_body = shell_body;
+  f.shell_reference = shell_reference;
+  f.shell_displacement = shell_u;
+  f.shell_velocity = shell_v;
   fields_->write(block, f);
 }
 
