@@ -97,6 +97,15 @@ void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, 
         std::string("write dataset ") + name);
 }
 
+/// Rows of 6 in Voigt order xx yy zz yz xz xy, as XDMF's Tensor6 order xx xy xz yy yz zz.
+std::vector<double> tensor6_rows(std::span<const double> voigt) {
+  constexpr std::array<int, 6> tensor6_from_voigt{0, 5, 4, 1, 3, 2};
+  std::vector<double> out(voigt.size());
+  for (size_t i = 0; i + 6 <= voigt.size(); i += 6)
+    for (int c = 0; c < 6; ++c) out[i + c] = voigt[i + tensor6_from_voigt[c]];
+  return out;
+}
+
 /// Writes a scalar attribute (collective: every rank passes the same value).
 void write_attribute(hid_t object, const char* name, hid_t type, const void* value) {
   errno = 0;
@@ -190,6 +199,8 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
       data_item(os, t + " 3", "Int", 8, mesh + "/shell_topology");
       os << "        </Topology>\n";
       geometry_and_motion(std::to_string(f.shell_vertices), "shell_");
+      attribute(os, "membrane_force", "Tensor6", "Cell", t + " 6", "Float", 8, step + "/shell_membrane_force");
+      attribute(os, "bending_moment", "Tensor6", "Cell", t + " 6", "Float", 8, step + "/shell_bending_moment");
       attribute(os, "body", "Scalar", "Cell", t, "Int", 4, mesh + "/shell_body");
       os << "      </Grid>\n";
       os << "      </Grid>\n";
@@ -347,6 +358,8 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   expect_size("shell_body", frame.shell_body.size(), frame.shell_triangles.size());
   expect_size("shell_displacement", frame.shell_displacement.size(), frame.shell_reference.size());
   expect_size("shell_velocity", frame.shell_velocity.size(), frame.shell_reference.size());
+  expect_size("shell_membrane_force", frame.shell_membrane_force.size(), 6 * frame.shell_triangles.size());
+  expect_size("shell_bending_moment", frame.shell_bending_moment.size(), 6 * frame.shell_triangles.size());
   require_all(error.str(), s.comm);
 
   // Global placement: [0] nodes, [1] elements.
@@ -425,20 +438,19 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
              frame.displacement.data(), node_rows, 3);
   write_rows(group.get(), "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.velocity.data(),
              node_rows, 3);
-  // Voigt xx yy zz yz xz xy -> XDMF Tensor6 xx xy xz yy yz zz.
-  constexpr std::array<int, 6> tensor6_from_voigt{0, 5, 4, 1, 3, 2};
-  std::vector<double> stress(6 * e);
-  for (size_t i = 0; i < e; ++i)
-    for (int c = 0; c < 6; ++c) stress[6 * i + c] = frame.stress[6 * i + tensor6_from_voigt[c]];
   if (!frame.shell_triangles.empty()) {
-    const hsize_t v = frame.shell_displacement.size();
-    const Rows vertex_rows{v, 0, v};
+    const hsize_t v = frame.shell_displacement.size(), t = frame.shell_triangles.size();
+    const Rows vertex_rows{v, 0, v}, triangle_rows{t, 0, t};
     write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_displacement.data(),
                vertex_rows, 3);
     write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_velocity.data(),
                vertex_rows, 3);
+    const std::vector<double> n = tensor6_rows(frame.shell_membrane_force), m = tensor6_rows(frame.shell_bending_moment);
+    write_rows(group.get(), "shell_membrane_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, n.data(), triangle_rows, 6);
+    write_rows(group.get(), "shell_bending_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, m.data(), triangle_rows, 6);
   }
   if (total[1] > 0) {
+    const std::vector<double> stress = tensor6_rows(frame.stress);
     write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
     write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(), elem_rows, 0);
     write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);

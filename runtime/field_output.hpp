@@ -25,6 +25,9 @@
 //   /mesh/<k>/shell_body    s int32, the body of each shell triangle
 //   /step_<NNNNNN>/shell_displacement, shell_velocity  v x 3 float64, of the
 //                           limit surface at the control vertices, m and m/s
+//   /step_<NNNNNN>/shell_membrane_force, shell_bending_moment  s x 6 float64,
+//                           the triangles' stress resultants (ShellResultants)
+//                           in Tensor6 order xx xy xz yy yz zz, N/m and N m/m
 // and each frame is a spatial collection of two grids, "solids" (the
 // tetrahedra, left out when there are none) and "shells" (the mid-surface:
 // the control triangles with their corners on the limit surface).
@@ -72,6 +75,9 @@ struct FieldFrame {
   std::span<const std::array<Index, 3>> shell_triangles;
   std::span<const int> shell_body;
   std::span<const Vec3> shell_reference, shell_displacement, shell_velocity;
+  /// [s*6 + c] per shell triangle, its membrane force (N/m) and bending
+  /// moment (N m/m) in Voigt order c = xx yy zz yz xz xy.
+  std::span<const double> shell_membrane_force, shell_bending_moment;
 };
 
 /// Writes fields.h5 and its XDMF index fields.xdmf into one directory.

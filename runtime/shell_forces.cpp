@@ -10,6 +10,14 @@ namespace shatter {
 
 namespace {
 
+/// The positions of the K entries of triangle t's patch (ghosts from their rules).
+template <int K>
+Eigen::Matrix<double, 3, K> patch_positions(const ShellBody& s, Index t, std::span<const Vec3> x) {
+  Eigen::Matrix<double, 3, K> xe;
+  for (int a = 0; a < K; ++a) xe.col(a) = s.mesh.entry_position(x, s.mesh.patch_of(t)[a]);
+  return xe;
+}
+
 /// The forces, energy and stable step of every patch of `set` (in parallel).
 template <int N>
 void compute_set(const ShellBody& s, const ShellPatchSet& set, const NeoHookean& mat, std::span<const Vec3> x,
@@ -19,10 +27,8 @@ void compute_set(const ShellBody& s, const ShellPatchSet& set, const NeoHookean&
   const auto& basis = shell_basis<N>();
   parallel_for_each(static_cast<Index>(set.triangle.size()), [&](Index p) {
     const Index t = set.triangle[p];
-    const Index* entries = s.mesh.patch_of(t);
-    Eigen::Matrix<double, 3, K> xe;
-    for (int a = 0; a < K; ++a) xe.col(a) = s.mesh.entry_position(x, entries[a]);
-    const ShellForce<K> out = shell_internal_force<K, kShellPoints>(xe, basis, set.reference[p], mat);
+    const ShellForce<K> out =
+        shell_internal_force<K, kShellPoints>(patch_positions<K>(s, t, x), basis, set.reference[p], mat);
     Vec3* f = slot_force.data() + set.first_slot + static_cast<Index>(p) * K;
     for (int a = 0; a < K; ++a) f[a] = out.f.col(a);
     const auto& c = s.mesh.triangles[t];
@@ -42,6 +48,26 @@ ShellForces::ShellForces(const Model& model) : model_(model) {
     patch_dt_.emplace_back(patches);
     elements_ += patches;
   }
+}
+
+std::vector<ShellResultants> ShellForces::resultants(std::span<const Vec3> x) const {
+  std::vector<ShellResultants> out;
+  for (const ShellBody& s : model_.shells) {
+    const NeoHookean& mat = model_.materials[s.material];
+    const std::span<const Vec3> xs = x.subspan(s.first_node, s.mesh.num_vertices());
+    const std::size_t first = out.size();
+    out.resize(first + s.mesh.num_triangles());
+    for (const ShellPatchSet& set : s.sets)
+      with_valence(set.valence, [&](auto N) {
+        constexpr int K = N() + 6;
+        parallel_for_each(static_cast<Index>(set.triangle.size()), [&](Index p) {
+          const Index t = set.triangle[p];
+          out[first + t] =
+              shell_resultants<K, kShellPoints>(patch_positions<K>(s, t, xs), shell_basis<N()>(), set.reference[p], mat);
+        });
+      });
+  }
+  return out;
 }
 
 ShellLoopResult ShellForces::compute(std::span<const Vec3> x, std::span<Vec3> f_int) const {

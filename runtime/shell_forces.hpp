@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "kernels/shell_kl.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {
@@ -27,6 +28,11 @@ class ShellForces {
   /// f_int of the shell bodies' nodes = dE/dx at positions x (overwrites
   /// their rows; the solids' rows are left as they are).
   ShellLoopResult compute(std::span<const Vec3> x, std::span<Vec3> f_int) const;
+
+  /// The stress resultants (membrane force, bending moment; ShellResultants)
+  /// of every shell triangle at positions x: body after body, each body's
+  /// triangles in its control mesh's order.
+  std::vector<ShellResultants> resultants(std::span<const Vec3> x) const;
 
   /// Shell elements computed per call.
   Index elements() const { return elements_; }

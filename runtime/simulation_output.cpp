@@ -153,8 +153,18 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
       shell_v.push_back(dv);
     }
   }
+  std::vector<double> shell_n, shell_m;
+  if (shells_)
+    for (const ShellResultants& r : shells_->resultants(x_))
+      for (int c = 0; c < 6; ++c) {
+        constexpr int row[6] = {0, 1, 2, 1, 0, 0}, col[6] = {0, 1, 2, 2, 2, 1};  // Voigt xx yy zz yz xz xy
+        shell_n.push_back(r.n(row[c], col[c]));
+        shell_m.push_back(r.m(row[c], col[c]));
+      }
   f.shell_triangles = shell_triangles;
   f.shell_body = shell_body;
+  f.shell_membrane_force = shell_n;
+  f.shell_bending_moment = shell_m;
   f.shell_reference = shell_reference;
   f.shell_displacement = shell_u;
   f.shell_velocity = shell_v;

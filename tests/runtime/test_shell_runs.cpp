@@ -152,6 +152,29 @@ TEST(ShellRuns, LimitStencilsAgreeWithThePatches) {
   EXPECT_GT(extraordinary, 50);
 }
 
+// The fields' membrane force on a sphere inflated uniformly by a strain eps
+// (every control vertex scaled by 1 + eps, so is the limit surface): in every
+// triangle n = E t eps / (1 - nu) (I - a3 a3) to O(eps, (t/R)^2) (plane-stress
+// membrane theory): its in-plane trace to 0.2 %.
+TEST(ShellRuns, MembraneForceOfAnInflatedSphere) {
+  const double R = 0.12, t = 0.0035, eps = 1e-5;
+  Model m = sphere_model("shell_inflate", R, t, 0.03, "");
+  std::vector<Vec3> x = m.mesh.reference;
+  for (Vec3& p : x) p *= 1 + eps;
+  const std::vector<ShellResultants> r = ShellForces(m).resultants(x);
+  ASSERT_EQ(r.size(), static_cast<size_t>(m.shells[0].mesh.num_triangles()));
+  const double expected = kYoung * t * eps / (1 - kPoisson);
+  for (size_t k = 0; k < r.size(); ++k) {
+    EXPECT_NEAR(0.5 * r[k].n.trace(), expected, 2e-3 * expected) << "triangle " << k;
+    // Isotropic in the tangent plane: eigenvalues (0, expected, expected), up to
+    // the spread of the normal over the triangle's three points (~0.1 rad here).
+    const Eigen::Vector3d lambda = Eigen::SelfAdjointEigenSolver<Mat3>(r[k].n).eigenvalues();
+    EXPECT_LT(std::abs(lambda[0]), 0.03 * expected) << "triangle " << k;
+    EXPECT_NEAR(lambda[1], expected, 0.03 * expected) << "triangle " << k;
+    EXPECT_NEAR(lambda[2], expected, 0.03 * expected) << "triangle " << k;
+  }
+}
+
 // A free shell spinning at ~10 m/s on its equator and translating: linear and
 // angular momentum to round-off, and the ledger's total energy within 1e-6 of
 // the kinetic energy (docs/shells.md "Measured": the figure over 1e5 steps).
