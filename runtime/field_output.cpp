@@ -355,11 +355,13 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   expect_size("body", frame.body.size(), e);
   if (has[0]) expect_size("fragment", frame.fragment.size(), e);
   if (has[1]) expect_size("damage", frame.damage.size(), e);
-  expect_size("shell_body", frame.shell_body.size(), frame.shell_triangles.size());
-  expect_size("shell_displacement", frame.shell_displacement.size(), frame.shell_reference.size());
-  expect_size("shell_velocity", frame.shell_velocity.size(), frame.shell_reference.size());
-  expect_size("shell_membrane_force", frame.shell_membrane_force.size(), 6 * frame.shell_triangles.size());
-  expect_size("shell_bending_moment", frame.shell_bending_moment.size(), 6 * frame.shell_triangles.size());
+  const ShellFrame no_shells;
+  const ShellFrame& sh = frame.shells ? *frame.shells : no_shells;
+  expect_size("shell_body", sh.body.size(), sh.triangles.size());
+  expect_size("shell_displacement", sh.displacement.size(), sh.reference.size());
+  expect_size("shell_velocity", sh.velocity.size(), sh.reference.size());
+  expect_size("shell_membrane_force", sh.membrane_force.size(), 6 * sh.triangles.size());
+  expect_size("shell_bending_moment", sh.bending_moment.size(), 6 * sh.triangles.size());
   require_all(error.str(), s.comm);
 
   // Global placement: [0] nodes, [1] elements.
@@ -402,19 +404,19 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
     // A model of shells alone has no element datasets (fields.xdmf names none).
     if (total[1] > 0)
       write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(), elem_rows, k);
-    if (!frame.shell_triangles.empty()) {
+    if (!sh.triangles.empty()) {
       // One rank (shells are not cut into parts): its rows are all of them.
-      const hsize_t t = frame.shell_triangles.size(), v = frame.shell_reference.size();
+      const hsize_t t = sh.triangles.size(), v = sh.reference.size();
       const Rows triangle_rows{t, 0, t}, vertex_rows{v, 0, v};
       std::vector<std::int64_t> triangles;
-      for (const auto& c : frame.shell_triangles) triangles.insert(triangles.end(), c.begin(), c.end());
-      write_rows(group.get(), "shell_coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_reference.data(),
+      for (const auto& c : sh.triangles) triangles.insert(triangles.end(), c.begin(), c.end());
+      write_rows(group.get(), "shell_coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.reference.data(),
                  vertex_rows, 3);
       write_rows(group.get(), "shell_topology", H5T_NATIVE_INT64, H5T_STD_I64LE, triangles.data(), triangle_rows, 3);
-      write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.shell_body.data(), triangle_rows, 0);
+      write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, sh.body.data(), triangle_rows, 0);
     }
-    s.mesh_triangles = static_cast<long long>(frame.shell_triangles.size());
-    s.mesh_shell_vertices = static_cast<long long>(frame.shell_reference.size());
+    s.mesh_triangles = static_cast<long long>(sh.triangles.size());
+    s.mesh_shell_vertices = static_cast<long long>(sh.reference.size());
     s.mesh_revision = mesh.revision;
     s.mesh_order = order;
     s.mesh_nodes = total[0];
@@ -438,14 +440,14 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
              frame.displacement.data(), node_rows, 3);
   write_rows(group.get(), "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.velocity.data(),
              node_rows, 3);
-  if (!frame.shell_triangles.empty()) {
-    const hsize_t v = frame.shell_displacement.size(), t = frame.shell_triangles.size();
+  if (!sh.triangles.empty()) {
+    const hsize_t v = sh.displacement.size(), t = sh.triangles.size();
     const Rows vertex_rows{v, 0, v}, triangle_rows{t, 0, t};
-    write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_displacement.data(),
+    write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.displacement.data(),
                vertex_rows, 3);
-    write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.shell_velocity.data(),
+    write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.velocity.data(),
                vertex_rows, 3);
-    const std::vector<double> n = tensor6_rows(frame.shell_membrane_force), m = tensor6_rows(frame.shell_bending_moment);
+    const std::vector<double> n = tensor6_rows(sh.membrane_force), m = tensor6_rows(sh.bending_moment);
     write_rows(group.get(), "shell_membrane_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, n.data(), triangle_rows, 6);
     write_rows(group.get(), "shell_bending_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, m.data(), triangle_rows, 6);
   }

@@ -46,11 +46,14 @@
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "kernels/types.hpp"
 #include "mesh/mesh.hpp"
 
 namespace shatter {
+
+struct ShellFrame;
 
 /// Fields of one output frame for the items this rank writes (all of them on
 /// 1 rank). Row i of a per-node array belongs to node i of the Mesh passed
@@ -68,16 +71,21 @@ struct FieldFrame {
   std::span<const int> fragment;
   /// [e] per element, damage in [0, 1]; optional (empty = not written).
   std::span<const double> damage;
-  /// Shells (on one rank only: shells are not cut into parts; empty without
-  /// them): [s] control triangles in rows of the [v] shell vertices, and
-  /// their bodies; per shell vertex its reference limit point (m), and the
-  /// limit surface's displacement (m) and velocity (m/s) there.
-  std::span<const std::array<Index, 3>> shell_triangles;
-  std::span<const int> shell_body;
-  std::span<const Vec3> shell_reference, shell_displacement, shell_velocity;
-  /// [s*6 + c] per shell triangle, its membrane force (N/m) and bending
-  /// moment (N m/m) in Voigt order c = xx yy zz yz xz xy.
-  std::span<const double> shell_membrane_force, shell_bending_moment;
+  /// The shells' mid-surface (ShellFrame); null without shells.
+  const ShellFrame* shells = nullptr;
+};
+
+/// The shells' mid-surface in one frame (on one rank only: shells are not cut
+/// into parts), s triangles and v control vertices, body after body.
+struct ShellFrame {
+  std::vector<std::array<Index, 3>> triangles;  ///< [s] control triangles, in rows of the shell vertices
+  std::vector<int> body;                         ///< [s] body index
+  /// [v] the limit surface at the control vertices: reference point (m),
+  /// displacement (m) and velocity (m/s)
+  std::vector<Vec3> reference, displacement, velocity;
+  /// [s*6 + c] membrane force (N/m) and bending moment (N m/m) of each
+  /// triangle, Voigt order c = xx yy zz yz xz xy
+  std::vector<double> membrane_force, bending_moment;
 };
 
 /// Writes fields.h5 and its XDMF index fields.xdmf into one directory.
