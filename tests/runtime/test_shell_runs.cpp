@@ -177,7 +177,7 @@ TEST(ShellRuns, MembraneForceOfAnInflatedSphere) {
 
 // A free shell spinning at ~10 m/s on its equator and translating: linear and
 // angular momentum to round-off, and the ledger's total energy within 1e-6 of
-// the kinetic energy (docs/shells.md "Measured": the figure over 1e5 steps).
+// the kinetic energy (docs/shells.md "Measured through the runtime": 1e5 steps).
 TEST(ShellRuns, SpinningSphereKeepsMomentaAndEnergy) {
   const double R = 0.12, t = 0.0035;
   Model m = sphere_model("shell_spin", R, t, 0.03, "    initial_velocity: [5, -2, 1]\n    angular_velocity: [0, 30, 80]\n");
