@@ -46,6 +46,9 @@ void print_check(const Model& model, const Simulation& sim) {
   std::vector<long> count(2 * nb, 0);  // per body: nodes, elements
   for (Index i : d.owned_nodes()) ++count[2 * mesh.node_body[i]];
   for (Index e : d.owned_element_ids()) ++count[2 * mesh.elem_body[e] + 1];
+  long shell_triangles = 0;  // a shell body's elements: its control triangles (one rank)
+  for (const ShellBody& sb : model.shells) count[2 * sb.body + 1] += sb.mesh.num_triangles();
+  for (const ShellBody& sb : model.shells) shell_triangles += sb.mesh.num_triangles();
   count = d.sum(count);
   MeshScaledJacobian worst;
   if (mesh.order == 2) {
@@ -66,8 +69,9 @@ void print_check(const Model& model, const Simulation& sim) {
                 model.body_volume[b]);
   double mass = 0;
   for (double m : model.body_mass) mass += m;
-  std::printf("total: %d nodes, %d elements (TET%d), mass %.6e kg\n", model.whole_nodes(), model.whole_elements(),
-              mesh.nodes_per_element(), mass);
+  std::printf("total: %d nodes, %d elements (TET%d)", model.whole_nodes(), model.whole_elements(), mesh.nodes_per_element());
+  if (shell_triangles > 0) std::printf(", %ld shell triangles", shell_triangles);
+  std::printf(", mass %.6e kg\n", mass);
   if (mesh.order == 2)
     std::printf("TET10 minimum scaled Jacobian %.4f (element %lld; det J / (6 x volume) at the quadrature points, 1 "
                 "for straight-sided elements, valid above 0)\n",

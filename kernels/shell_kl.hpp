@@ -133,6 +133,27 @@ ShellReference<NQ> shell_reference(const Eigen::Matrix<double, 3, NV>& X,
   return ref;
 }
 
+/// The stress resultants of one quadrature point q (ref[q]), contravariant in
+/// the convected frame, with the point's weights included: N = sum_k w_k S_k,
+/// M = sum_k w_k theta_3k S_k (w_k = ShellReferencePoint::weight), and its
+/// strain energy sum_k w_k W_k (J).
+struct ShellPointResultants {
+  Mat2 N, M;
+  double energy;
+};
+inline ShellPointResultants shell_point_resultants(const ShellSurfacePoint& p, const ShellReferencePoint& r,
+                                                   const NeoHookean& mat) {
+  ShellPointResultants out{Mat2::Zero(), Mat2::Zero(), 0.0};
+  for (int k = 0; k < kShellThicknessPoints; ++k) {
+    const Mat2 g = p.metric - 2.0 * r.theta3[k] * p.curvature;
+    const PlaneStressPoint s = neo_hookean_plane_stress(mat, g, r.G_inv[k], r.ln_det_G[k]);
+    out.energy += r.weight[k] * s.energy;
+    out.N += r.weight[k] * s.S;
+    out.M += (r.weight[k] * r.theta3[k]) * s.S;
+  }
+  return out;
+}
+
 /// Internal forces dPi/dx_a (N, column a = control vertex a) and strain energy Pi (J).
 template <int NV>
 struct ShellForce {
@@ -150,15 +171,8 @@ ShellForce<NV> shell_internal_force(const Eigen::Matrix<double, 3, NV>& x,
   for (int q = 0; q < NQ; ++q) {
     const SubdivisionBasis<NV>& B = basis[q];
     const ShellSurfacePoint p = shell_surface_point<NV>(x, B);
-    const ShellReferencePoint& r = ref[q];
-    Mat2 N = Mat2::Zero(), M = Mat2::Zero();
-    for (int k = 0; k < kShellThicknessPoints; ++k) {
-      const Mat2 g = p.metric - 2.0 * r.theta3[k] * p.curvature;
-      const PlaneStressPoint s = neo_hookean_plane_stress(mat, g, r.G_inv[k], r.ln_det_G[k]);
-      out.energy += r.weight[k] * s.energy;
-      N += r.weight[k] * s.S;
-      M += (r.weight[k] * r.theta3[k]) * s.S;
-    }
+    const auto [N, M, energy] = shell_point_resultants(p, ref[q], mat);
+    out.energy += energy;
     const Vec3 n1 = N(0, 0) * p.a1 + N(0, 1) * p.a2;
     const Vec3 n2 = N(1, 0) * p.a1 + N(1, 1) * p.a2;
     const Vec3 v = M(0, 0) * p.a11 + 2.0 * M(0, 1) * p.a12 + M(1, 1) * p.a22;
@@ -173,6 +187,35 @@ ShellForce<NV> shell_internal_force(const Eigen::Matrix<double, 3, NV>& x,
 /// Lumped (row-sum) mass of the element's control vertices, kg:
 /// m_a = rho t sum_q w_q J0_q N_a (row sums of the consistent mass; a sum over the
 /// elements gives each vertex rho t int N_a dA, total rho t x area).
+/// The element's stress resultants in the global frame, averaged over its
+/// quadrature points by their reference areas: the membrane force
+/// n = N^{alpha beta} a_alpha (x) a_beta (N/m) and the bending moment
+/// m = M^{alpha beta} a_alpha (x) a_beta (N m / m), per unit reference area
+/// (second Piola-Kirchhoff resultants pushed forward with the current base
+/// vectors, i.e. Kirchhoff-type; Cirak & Ortiz 2001).
+struct ShellResultants {
+  Mat3 n, m;
+};
+template <int NV, int NQ>
+ShellResultants shell_resultants(const Eigen::Matrix<double, 3, NV>& x,
+                                 const std::array<SubdivisionBasis<NV>, NQ>& basis, const ShellReference<NQ>& ref,
+                                 const NeoHookean& mat) {
+  ShellResultants out{Mat3::Zero(), Mat3::Zero()};
+  double area = 0;
+  for (int q = 0; q < NQ; ++q) {
+    const ShellSurfacePoint p = shell_surface_point<NV>(x, basis[q]);
+    const ShellPointResultants r = shell_point_resultants(p, ref[q], mat);
+    Eigen::Matrix<double, 3, 2> a;
+    a << p.a1, p.a2;
+    out.n += a * r.N * a.transpose();
+    out.m += a * r.M * a.transpose();
+    area += ref[q].area_weight;
+  }
+  out.n /= area;
+  out.m /= area;
+  return out;
+}
+
 template <int NV, int NQ>
 Eigen::Matrix<double, NV, 1> shell_lumped_mass(const std::array<SubdivisionBasis<NV>, NQ>& basis,
                                                const ShellReference<NQ>& ref, double thickness, double density) {

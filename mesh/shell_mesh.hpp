@@ -5,6 +5,7 @@
 // i.e. the triangle's corners and their 1-rings.
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -86,7 +87,7 @@ struct ShellMesh {
   Index patch_size(Index t) const { return patch_offsets[t + 1] - patch_offsets[t]; }
 
   /// Position of patch entry `id` (a vertex, or ghost id - n) from the vertex positions x.
-  Vec3 entry_position(const std::vector<Vec3>& x, Index id) const {
+  Vec3 entry_position(std::span<const Vec3> x, Index id) const {
     if (id < num_vertices()) return x[id];
     const Index g = id - num_vertices();
     const auto& [b1, b2, a] = ghost_rule[g];

@@ -29,8 +29,17 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
     granule_rank_ = model.part.granule_rank;
   } else {
     check_ranks(model, size_);
-    granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
+    granule_rank_ = size_ == 1 ? std::vector<int>((mesh.num_elements() + ElementForces::kGranule - 1) /
+                                                      ElementForces::kGranule,
+                                                  0)
+                               : partition_granules(mesh, ElementForces::kGranule, size_);
   }
+  // Shell nodes (on one rank, model.cpp): granules of their own, past the elements'.
+  first_shell_granule_ = num_granules();
+  if (!model.shells.empty())
+    granule_rank_.resize(first_shell_granule_ + (mesh.num_nodes() - model.shells.front().first_node +
+                                                 ElementForces::kGranule - 1) / ElementForces::kGranule,
+                         0);
   for (Index g = 0; g < num_granules(); ++g)
     if (granule_rank_[g] == rank_) owned_granules_.push_back(g);
   for (Index e = 0; e < mesh.num_elements(); ++e)
@@ -43,7 +52,7 @@ Decomposition::~Decomposition() = default;
 
 void check_ranks(const Model& model, int ranks) {
   const Index ne = model.whole_elements(), ng = (ne + ElementForces::kGranule - 1) / ElementForces::kGranule;
-  if (ranks > ng)
+  if (ranks > 1 && ranks > ng)
     throw InputError(model.scene.file + ": the mesh has " + std::to_string(ne) + " elements, " +
                      std::to_string(ng) + (ng == 1 ? " granule of " : " granules of ") + std::to_string(ElementForces::kGranule) +
                      "; it cannot be shared by " + std::to_string(ranks) + " MPI ranks (use at most " +
@@ -69,8 +78,10 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
   // On a part, a ghost-only node's star may not be whole here, but none of
   // it is owned here, so neither is the granule computed; a contact-surface
   // node outside the part's elements has no star and no home granule (-1).
+  const Index first_shell_node = model_.shells.empty() ? nn : model_.shells.front().first_node;
   for (Index n = 0; n < nn; ++n)
-    home_granule_[n] = mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
+    home_granule_[n] = n >= first_shell_node ? first_shell_granule_ + (n - first_shell_node) / ElementForces::kGranule
+                       : mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
                            ? -1
                            : model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
   {

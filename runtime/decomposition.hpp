@@ -26,7 +26,10 @@
 // sums are added exactly (ExactSum, kernels/exact_sum.hpp) and reduced over
 // the ranks by one reduction of constant size (sum()). The result is the
 // same double on every rank and for any decomposition and thread count.
-// With one rank (or MPI not initialised) nothing is communicated.
+// With one rank (or MPI not initialised) nothing is communicated. Shell
+// nodes (one rank only, runtime/shell_model.hpp) are in no element: they
+// have granules of their own, of ElementForces::kGranule consecutive shell
+// nodes, after the elements' granules.
 #include <mpi.h>
 
 #include <memory>
@@ -171,6 +174,9 @@ class Decomposition {
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0, size_ = 1;
   std::vector<int> granule_rank_;
+  /// The first granule of the shell nodes (kGranule consecutive shell nodes
+  /// each, past the elements' granules; a shell node's home granule).
+  Index first_shell_granule_ = 0;
   std::vector<Index> owned_granules_;
   Index owned_elements_ = 0;
   std::vector<Index> node_rank_offsets_;

@@ -97,6 +97,15 @@ void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, 
         std::string("write dataset ") + name);
 }
 
+/// Rows of 6 in Voigt order xx yy zz yz xz xy, as XDMF's Tensor6 order xx xy xz yy yz zz.
+std::vector<double> tensor6_rows(std::span<const double> voigt) {
+  constexpr std::array<int, 6> tensor6_from_voigt{0, 5, 4, 1, 3, 2};
+  std::vector<double> out(voigt.size());
+  for (size_t i = 0; i + 6 <= voigt.size(); i += 6)
+    for (int c = 0; c < 6; ++c) out[i + c] = voigt[i + tensor6_from_voigt[c]];
+  return out;
+}
+
 /// Writes a scalar attribute (collective: every rank passes the same value).
 void write_attribute(hid_t object, const char* name, hid_t type, const void* value) {
   errno = 0;
@@ -116,6 +125,8 @@ struct FrameRecord {
   long long elements;
   bool fragment;
   bool damage;
+  long long triangles;       ///< shell triangles
+  long long shell_vertices;  ///< shell control vertices
 };
 
 std::string step_group_name(int step) {
@@ -154,23 +165,46 @@ std::string xdmf_text(const std::vector<FrameRecord>& frames) {
     const std::string step = step_group_name(f.step);
     const std::string n = std::to_string(f.nodes), e = std::to_string(f.elements);
     const int k = f.order == 1 ? 4 : 10;
-    os << "      <Grid Name=\"" << step.substr(1) << "\" GridType=\"Uniform\">\n"
-       << "        <Time Value=\"" << f.time << "\"/>\n"
-       << "        <Topology TopologyType=\"" << (f.order == 1 ? "Tetrahedron" : "Tetrahedron_10")
-       << "\" NumberOfElements=\"" << e << "\">\n";
-    data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
-    os << "        </Topology>\n"
-       << "        <Geometry GeometryType=\"XYZ\">\n";
-    data_item(os, n + " 3", "Float", 8, mesh + "/coordinates");
-    os << "        </Geometry>\n";
-    attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/displacement");
-    attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/velocity");
-    attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
-    attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
-    attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
-    if (f.fragment) attribute(os, "fragment", "Scalar", "Cell", e, "Int", 4, step + "/fragment");
-    if (f.damage) attribute(os, "damage", "Scalar", "Cell", e, "Float", 8, step + "/damage");
-    os << "      </Grid>\n";
+    // The points (n of them, named prefix + coordinates etc.) with their displacement and velocity.
+    auto geometry_and_motion = [&](const std::string& n, const std::string& prefix) {
+      os << "        <Geometry GeometryType=\"XYZ\">\n";
+      data_item(os, n + " 3", "Float", 8, mesh + "/" + prefix + "coordinates");
+      os << "        </Geometry>\n";
+      attribute(os, "displacement", "Vector", "Node", n + " 3", "Float", 8, step + "/" + prefix + "displacement");
+      attribute(os, "velocity", "Vector", "Node", n + " 3", "Float", 8, step + "/" + prefix + "velocity");
+    };
+    const bool shells = f.triangles > 0;
+    if (shells)
+      os << "      <Grid Name=\"" << step.substr(1) << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+         << "        <Time Value=\"" << f.time << "\"/>\n";
+    if (!shells || f.elements > 0) {
+      os << "      <Grid Name=\"" << (shells ? std::string("solids") : step.substr(1)) << "\" GridType=\"Uniform\">\n";
+      if (!shells) os << "        <Time Value=\"" << f.time << "\"/>\n";
+      os << "        <Topology TopologyType=\"" << (f.order == 1 ? "Tetrahedron" : "Tetrahedron_10")
+         << "\" NumberOfElements=\"" << e << "\">\n";
+      data_item(os, e + " " + std::to_string(k), "Int", 8, mesh + "/topology");
+      os << "        </Topology>\n";
+      geometry_and_motion(n, "");
+      attribute(os, "stress", "Tensor6", "Cell", e + " 6", "Float", 8, step + "/stress");
+      attribute(os, "von_mises", "Scalar", "Cell", e, "Float", 8, step + "/von_mises");
+      attribute(os, "body", "Scalar", "Cell", e, "Int", 4, step + "/body");
+      if (f.fragment) attribute(os, "fragment", "Scalar", "Cell", e, "Int", 4, step + "/fragment");
+      if (f.damage) attribute(os, "damage", "Scalar", "Cell", e, "Float", 8, step + "/damage");
+      os << "      </Grid>\n";
+    }
+    if (shells) {
+      const std::string t = std::to_string(f.triangles);
+      os << "      <Grid Name=\"shells\" GridType=\"Uniform\">\n"
+         << "        <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << t << "\">\n";
+      data_item(os, t + " 3", "Int", 8, mesh + "/shell_topology");
+      os << "        </Topology>\n";
+      geometry_and_motion(std::to_string(f.shell_vertices), "shell_");
+      attribute(os, "membrane_force", "Tensor6", "Cell", t + " 6", "Float", 8, step + "/shell_membrane_force");
+      attribute(os, "bending_moment", "Tensor6", "Cell", t + " 6", "Float", 8, step + "/shell_bending_moment");
+      attribute(os, "body", "Scalar", "Cell", t, "Int", 4, mesh + "/shell_body");
+      os << "      </Grid>\n";
+      os << "      </Grid>\n";
+    }
   }
   os << "    </Grid>\n"
      << "  </Domain>\n"
@@ -218,7 +252,7 @@ struct FieldWriter::State {
   int mesh_count = 0;  ///< mesh groups written so far
   std::uint64_t mesh_revision = 0;
   int mesh_order = 0;
-  long long mesh_nodes = -1, mesh_elements = -1;
+  long long mesh_nodes = -1, mesh_elements = -1, mesh_triangles = 0, mesh_shell_vertices = 0;
   std::vector<FrameRecord> frames;
 
   void write_frame(const Mesh& mesh, const FieldFrame& frame);
@@ -321,6 +355,13 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   expect_size("body", frame.body.size(), e);
   if (has[0]) expect_size("fragment", frame.fragment.size(), e);
   if (has[1]) expect_size("damage", frame.damage.size(), e);
+  const ShellFrame no_shells;
+  const ShellFrame& sh = frame.shells ? *frame.shells : no_shells;
+  expect_size("shell_body", sh.body.size(), sh.triangles.size());
+  expect_size("shell_displacement", sh.displacement.size(), sh.reference.size());
+  expect_size("shell_velocity", sh.velocity.size(), sh.reference.size());
+  expect_size("shell_membrane_force", sh.membrane_force.size(), 6 * sh.triangles.size());
+  expect_size("shell_bending_moment", sh.bending_moment.size(), 6 * sh.triangles.size());
   require_all(error.str(), s.comm);
 
   // Global placement: [0] nodes, [1] elements.
@@ -360,8 +401,22 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
     std::vector<std::int64_t> topology(mesh.conn.begin(), mesh.conn.end());
     if (order == 2)
       for (size_t i = 0; i < e; ++i) std::swap(topology[i * k + 8], topology[i * k + 9]);
-    write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(),
-               elem_rows, k);
+    // A model of shells alone has no element datasets (fields.xdmf names none).
+    if (total[1] > 0)
+      write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(), elem_rows, k);
+    if (!sh.triangles.empty()) {
+      // One rank (shells are not cut into parts): its rows are all of them.
+      const hsize_t t = sh.triangles.size(), v = sh.reference.size();
+      const Rows triangle_rows{t, 0, t}, vertex_rows{v, 0, v};
+      std::vector<std::int64_t> triangles;
+      for (const auto& c : sh.triangles) triangles.insert(triangles.end(), c.begin(), c.end());
+      write_rows(group.get(), "shell_coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.reference.data(),
+                 vertex_rows, 3);
+      write_rows(group.get(), "shell_topology", H5T_NATIVE_INT64, H5T_STD_I64LE, triangles.data(), triangle_rows, 3);
+      write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, sh.body.data(), triangle_rows, 0);
+    }
+    s.mesh_triangles = static_cast<long long>(sh.triangles.size());
+    s.mesh_shell_vertices = static_cast<long long>(sh.reference.size());
     s.mesh_revision = mesh.revision;
     s.mesh_order = order;
     s.mesh_nodes = total[0];
@@ -385,27 +440,33 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
              frame.displacement.data(), node_rows, 3);
   write_rows(group.get(), "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.velocity.data(),
              node_rows, 3);
-  // Voigt xx yy zz yz xz xy -> XDMF Tensor6 xx xy xz yy yz zz.
-  constexpr std::array<int, 6> tensor6_from_voigt{0, 5, 4, 1, 3, 2};
-  std::vector<double> stress(6 * e);
-  for (size_t i = 0; i < e; ++i)
-    for (int c = 0; c < 6; ++c) stress[6 * i + c] = frame.stress[6 * i + tensor6_from_voigt[c]];
-  write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
-  write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(),
-             elem_rows, 0);
-  write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);
-  if (has[0])
-    write_rows(group.get(), "fragment", H5T_NATIVE_INT, H5T_STD_I32LE, frame.fragment.data(),
-               elem_rows, 0);
-  if (has[1])
-    write_rows(group.get(), "damage", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.damage.data(),
-               elem_rows, 0);
+  if (!sh.triangles.empty()) {
+    const hsize_t v = sh.displacement.size(), t = sh.triangles.size();
+    const Rows vertex_rows{v, 0, v}, triangle_rows{t, 0, t};
+    write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.displacement.data(),
+               vertex_rows, 3);
+    write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.velocity.data(),
+               vertex_rows, 3);
+    const std::vector<double> n = tensor6_rows(sh.membrane_force), m = tensor6_rows(sh.bending_moment);
+    write_rows(group.get(), "shell_membrane_force", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, n.data(), triangle_rows, 6);
+    write_rows(group.get(), "shell_bending_moment", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, m.data(), triangle_rows, 6);
+  }
+  if (total[1] > 0) {
+    const std::vector<double> stress = tensor6_rows(frame.stress);
+    write_rows(group.get(), "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, stress.data(), elem_rows, 6);
+    write_rows(group.get(), "von_mises", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.von_mises.data(), elem_rows, 0);
+    write_rows(group.get(), "body", H5T_NATIVE_INT, H5T_STD_I32LE, frame.body.data(), elem_rows, 0);
+    if (has[0])
+      write_rows(group.get(), "fragment", H5T_NATIVE_INT, H5T_STD_I32LE, frame.fragment.data(), elem_rows, 0);
+    if (has[1])
+      write_rows(group.get(), "damage", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.damage.data(), elem_rows, 0);
+  }
   group.reset();
   // The index may be opened while the run goes on: make the data it names durable first.
   check(H5Fflush(s.file.get(), H5F_SCOPE_GLOBAL), "flush fields.h5");
 
   s.frames.push_back(FrameRecord{frame.step, frame.time, mesh_index, s.mesh_order, total[0],
-                                 total[1], has[0] != 0, has[1] != 0});
+                                 total[1], has[0] != 0, has[1] != 0, s.mesh_triangles, s.mesh_shell_vertices});
   s.write_xdmf();
 }
 

@@ -18,6 +18,19 @@
 //       body                e int32
 //       fragment            e int32 (only when fracture is on)
 //       damage              e float64 (only when given)
+// With shells (v control vertices, s triangles; FieldFrame::shell_*):
+//   /mesh/<k>/shell_coordinates  v x 3 float64, the reference limit surface at
+//                           the control vertices, m
+//   /mesh/<k>/shell_topology  s x 3 int64, rows of shell_coordinates
+//   /mesh/<k>/shell_body    s int32, the body of each shell triangle
+//   /step_<NNNNNN>/shell_displacement, shell_velocity  v x 3 float64, of the
+//                           limit surface at the control vertices, m and m/s
+//   /step_<NNNNNN>/shell_membrane_force, shell_bending_moment  s x 6 float64,
+//                           the triangles' stress resultants (ShellResultants)
+//                           in Tensor6 order xx xy xz yy yz zz, N/m and N m/m
+// and each frame is a spatial collection of two grids, "solids" (the
+// tetrahedra, left out when there are none) and "shells" (the mid-surface:
+// the control triangles with their corners on the limit surface).
 // A mesh group k = 0, 1, ... is written for the first frame and again for
 // every frame whose mesh topology changed (fracture splits nodes).
 //
@@ -29,14 +42,18 @@
 // ParaView GUI labels in VTK's order (XX YY ZZ XY YZ XZ).
 #include <mpi.h>
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "kernels/types.hpp"
 #include "mesh/mesh.hpp"
 
 namespace shatter {
+
+struct ShellFrame;
 
 /// Fields of one output frame for the items this rank writes (all of them on
 /// 1 rank). Row i of a per-node array belongs to node i of the Mesh passed
@@ -54,6 +71,21 @@ struct FieldFrame {
   std::span<const int> fragment;
   /// [e] per element, damage in [0, 1]; optional (empty = not written).
   std::span<const double> damage;
+  /// The shells' mid-surface (ShellFrame); null without shells.
+  const ShellFrame* shells = nullptr;
+};
+
+/// The shells' mid-surface in one frame (on one rank only: shells are not cut
+/// into parts), s triangles and v control vertices, body after body.
+struct ShellFrame {
+  std::vector<std::array<Index, 3>> triangles;  ///< [s] control triangles, in rows of the shell vertices
+  std::vector<int> body;                         ///< [s] body index
+  /// [v] the limit surface at the control vertices: reference point (m),
+  /// displacement (m) and velocity (m/s)
+  std::vector<Vec3> reference, displacement, velocity;
+  /// [s*6 + c] membrane force (N/m) and bending moment (N m/m) of each
+  /// triangle, Voigt order c = xx yy zz yz xz xy
+  std::vector<double> membrane_force, bending_moment;
 };
 
 /// Writes fields.h5 and its XDMF index fields.xdmf into one directory.

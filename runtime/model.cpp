@@ -25,6 +25,17 @@ void check_estimate(const Scene& scene, double max_elements) {
   for (const BodySpec& body : scene.bodies) {
     if (!body.mesh_file.empty()) continue;
     const std::string where = scene.file + ": " + body.key + ".mesh";
+    if (body.shell) {
+      check_shape_extent(shell_extent(body.shell->shape), where);
+      total += estimated_shell_triangles(body.shell->shape);
+      if (total <= max_elements) continue;
+      std::ostringstream os;
+      os << where << ".element_size: about " << std::setprecision(3) << total
+         << " elements and shell triangles estimated for the scene so far (a shell: its area over an equilateral "
+            "triangle's of edge element_size); expected at most "
+         << max_elements << " (--max-elements raises the limit)";
+      throw InputError(os.str());
+    }
     check_shape_extent(body.shape, where);
     const double n = estimated_elements(body.shape);
     total += n;
@@ -49,6 +60,7 @@ Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vecto
     const std::string where = scene.file + ": " + body.key + ".mesh" +
                               (body.mesh_file.empty() ? "" : " (" + body.mesh_file + ")");
     std::vector<PhysicalGroup>& body_groups = groups.emplace_back();
+    if (body.shell) continue;  // add_shell_bodies
     Mesh part = body.mesh_file.empty() ? mesh_shape(body.shape, static_cast<int>(b), body.material, where)
                                        : read_mesh_file(body.mesh_file, body.mesh_physical, static_cast<int>(b),
                                                         body.material, where, &body_groups);
@@ -69,6 +81,27 @@ Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vecto
   // Gmsh's order, and 15 colors instead of 280; docs/performance.md).
   reorder_for_locality(mesh, GlobalIdPolicy::keep);
   return mesh;
+}
+
+/// The shell bodies of the scene (build_shell_body), their control vertices
+/// appended to `mesh` as nodes in no element, after the solids' nodes.
+std::vector<ShellBody> add_shell_bodies(const Scene& scene, Mesh& mesh) {
+  std::vector<ShellBody> shells;
+  if (mesh.node_elem_offsets.empty()) mesh.node_elem_offsets.push_back(0);
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    if (!scene.bodies[b].shell) continue;
+    ShellBody& s = shells.emplace_back(
+        build_shell_body(scene, static_cast<int>(b), scene.file + ": " + scene.bodies[b].key + ".mesh"));
+    s.first_node = mesh.num_nodes();
+    GlobalId gid = mesh.node_gid.empty() ? 0 : *std::max_element(mesh.node_gid.begin(), mesh.node_gid.end());
+    for (const Vec3& X : s.mesh.reference) {
+      mesh.reference.push_back(X);
+      mesh.node_gid.push_back(++gid);
+      mesh.node_body.push_back(static_cast<int>(b));
+      mesh.node_elem_offsets.push_back(mesh.node_elem_offsets.back());
+    }
+  }
+  return shells;
 }
 
 /// `f` on rank 0 of `comm`; a failure there is thrown on every rank
@@ -138,8 +171,14 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
   if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
   std::vector<std::vector<PhysicalGroup>> groups;
   RegionSelection selection;
+  if (ranks > 1 && scene.has_shells())
+    for (const BodySpec& b : scene.bodies)
+      if (b.shell)
+        throw InputError(scene.file + ": " + b.key + ".shell: shells run on one MPI rank (" + std::to_string(ranks) +
+                         " here; their parts and 2-ring ghost layer are not built yet); expected mpirun -np 1");
   if (ranks == 1) {
     m.mesh = mesh_bodies(scene, max_elements, groups);
+    m.shells = add_shell_bodies(scene, m.mesh);
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
   } else if (scene.fracture_enabled() && scene.contact) {
@@ -202,6 +241,17 @@ void complete_model(Model& m, const RegionSelection& selection) {
   for (Index e = 0; e < ne; ++e) {
     m.body_volume[mesh.elem_body[e]] += m.element_volume[e];
     m.body_mass[mesh.elem_body[e]] += m.element_volume[e] * m.materials[mesh.elem_material[e]].density;
+  }
+  for (const ShellBody& s : m.shells) {
+    const std::vector<double> mass = shell_vertex_mass(s, m.materials[s.material]);
+    for (Index v = 0; v < s.mesh.num_vertices(); ++v) {
+      if (!(mass[v] > 0))
+        throw InputError(scene.file + ": " + scene.bodies[s.body].key + ".mesh: control vertex " + std::to_string(v) +
+                         " of the shell has lumped mass " + std::to_string(mass[v]) + " kg; expected a positive mass");
+      m.mass[s.first_node + v] = mass[v];
+    }
+    m.body_volume[s.body] = s.thickness * s.area;
+    m.body_mass[s.body] = m.body_volume[s.body] * m.materials[s.material].density;
   }
 
   // Initial velocities: translation, rotation about the body's centre of
@@ -287,6 +337,13 @@ Index Model::local_element(Index whole) const {
 std::size_t model_bytes(const Model& m) {
   std::size_t bytes = 0;
   for_each_array(m, [&](const auto& v) { bytes += v.capacity() * sizeof(v[0]); });
+  for (const ShellBody& s : m.shells) {
+    bytes += s.mesh.reference.capacity() * sizeof(Vec3) + s.mesh.triangles.capacity() * sizeof(s.mesh.triangles[0]) +
+             (s.mesh.patch.capacity() + s.mesh.patch_offsets.capacity() + s.vertex_slot.capacity() +
+              s.vertex_slot_offsets.capacity()) * sizeof(Index) + s.vertex_slot_weight.capacity() * sizeof(double);
+    for (const ShellPatchSet& set : s.sets)
+      bytes += set.triangle.capacity() * sizeof(Index) + set.reference.capacity() * sizeof(set.reference[0]);
+  }
   return bytes;
 }
 

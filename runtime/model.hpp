@@ -15,6 +15,7 @@
 #include "mesh/mesh.hpp"
 #include "mesh/shape_estimate.hpp"
 #include "runtime/scene.hpp"
+#include "runtime/shell_model.hpp"
 
 namespace shatter {
 
@@ -47,8 +48,14 @@ struct Model {
   std::vector<LoadFace> load_faces;
   std::vector<Vec3> initial_velocity;        ///< per node, m/s
 
-  /// Total mass and volume of each body (of the whole model).
+  /// Total mass and volume of each body (of the whole model); a shell's
+  /// volume is its thickness times its reference limit surface's area.
   std::vector<double> body_mass, body_volume;
+
+  /// The shell bodies, in body order (docs/shells.md "The runtime"): their
+  /// control vertices are the model's last nodes (ShellBody::first_node), in
+  /// no element of `mesh`. Only on a whole model (shells run on one rank).
+  std::vector<ShellBody> shells;
 
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
   /// its owned elements and their ghost layer, ascending in the whole

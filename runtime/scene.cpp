@@ -263,6 +263,40 @@ ShapeSpec read_shape(const Reader& r, const YAML::Node& m, const std::string& ke
   return s;
 }
 
+/// A shell's mid-surface (bodies[i].mesh of a body with `shell`): sphere (its
+/// surface), disk, rectangle or cylinder (its side), thinner than the shape.
+ShellShapeSpec read_shell_shape(const Reader& r, const YAML::Node& m, const std::string& key, double thickness) {
+  ShellShapeSpec s;
+  s.shape = r.string(r.required(m, key, "shape"), key + ".shape");
+  if (s.shape == "sphere" || s.shape == "disk") {
+    r.only_keys(m, key, {"shape", "radius", "center", "element_size"});
+  } else if (s.shape == "cylinder") {
+    r.only_keys(m, key, {"shape", "radius", "length", "center", "axis", "element_size"});
+    s.length = r.positive(r.required(m, key, "length"), key + ".length");
+  } else if (s.shape == "rectangle") {
+    r.only_keys(m, key, {"shape", "width", "height", "center", "element_size"});
+    s.width = r.positive(r.required(m, key, "width"), key + ".width");
+    s.height = r.positive(r.required(m, key, "height"), key + ".height");
+  } else {
+    r.fail(key + ".shape", "one of sphere, disk, rectangle, cylinder (a shell's mid-surface)", m["shape"]);
+  }
+  if (s.shape != "rectangle") s.radius = r.positive(r.required(m, key, "radius"), key + ".radius");
+  if (m["center"]) s.center = r.vec3(m["center"], key + ".center");
+  if (m["axis"]) {
+    s.axis = r.vec3(m["axis"], key + ".axis");
+    if (s.axis.norm() == 0) r.fail(key + ".axis", "a non-zero direction", m["axis"]);
+  }
+  s.element_size = r.positive(r.required(m, key, "element_size"), key + ".element_size");
+  const double span = s.shape == "rectangle" ? std::min(s.width, s.height) : s.radius;
+  if (thickness >= span) {
+    std::ostringstream os;
+    os << thickness << " is not below the shape's " << (s.shape == "rectangle" ? "shorter side " : "radius ") << span
+       << " (" << key << "); expected a thin shell";
+    r.fail(key.substr(0, key.rfind('.')) + ".shell.thickness", os.str());
+  }
+  return s;
+}
+
 StrengthScatter strength_scatter(const Reader& r, const YAML::Node& n, const std::string& key) {
   r.only_keys(n, key, {"distribution", "modulus", "spread", "seed", "reference_area"});
   StrengthScatter s;
@@ -291,6 +325,10 @@ RegionSpec read_region(const Reader& r, const YAML::Node& n, const std::string& 
   r.only_keys(n, key, {"box", "physical", "face"});
   if (n.size() != 1) r.fail(key, "exactly one of box, physical, face", n);
   RegionSpec region;
+  if (body.shell && !n["box"])
+    r.fail(key, "{box: [[xmin, ymin, zmin], [xmax, ymax, zmax]]} for the shell body '" + body.name +
+                    "' (its control vertices inside; shells have no named faces or groups yet)",
+           n);
   if (const YAML::Node box = n["box"]) {
     const std::string bk = key + ".box";
     if (!box.IsSequence() || box.size() != 2) r.fail(bk, "[[xmin, ymin, zmin], [xmax, ymax, zmax]]", box);
@@ -501,7 +539,8 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     const std::string key = "bodies[" + std::to_string(i) + "]";
     const YAML::Node b = bodies[i];
     r.only_keys(b, key,
-                {"name", "material", "mesh", "initial_velocity", "angular_velocity", "velocity_gradient", "rigid"});
+                {"name", "material", "mesh", "shell", "initial_velocity", "angular_velocity", "velocity_gradient",
+                 "rigid"});
     BodySpec body;
     body.key = key;
     body.name = b["name"] ? r.string(b["name"], key + ".name") : "body" + std::to_string(i);
@@ -516,7 +555,26 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     const std::string mk = key + ".mesh";
     if (!mesh.IsMap()) r.fail(mk, "a mapping with either 'file' or 'shape'", mesh);
     if (mesh["file"] && mesh["shape"]) r.fail(mk, "exactly one of 'file' or 'shape', not both");
-    if (mesh["file"]) {
+    if (const YAML::Node shell = b["shell"]) {
+      const std::string sk = key + ".shell";
+      if (!shell.IsMap()) r.fail(sk, "a mapping {thickness: t}", shell);
+      r.only_keys(shell, sk, {"thickness"});
+      ShellSpec spec;
+      spec.thickness = r.positive(r.required(shell, sk, "thickness"), sk + ".thickness");
+      if (mesh["file"])
+        r.fail(mk + ".file", "expected a shape (sphere, disk, rectangle, cylinder) for the shell body '" + body.name +
+                                 "': .msh files of shells are not read yet");
+      if (!mesh["shape"]) r.fail(mk, "expected a shape (sphere, disk, rectangle, cylinder): the shell's mid-surface");
+      spec.shape = read_shell_shape(r, mesh, mk, spec.thickness);
+      if (s.materials[body.material].fracture)
+        r.fail(key + ".material",
+               "a material without a fracture block for the shell body '" + body.name + "' (shells do not fracture yet)",
+               b["material"]);
+      if (b["rigid"])
+        r.fail(key + ".rigid", "no rigid key for the shell body '" + body.name + "' (rigid shells are not supported yet)",
+               b["rigid"]);
+      body.shell = spec;
+    } else if (mesh["file"]) {
       r.only_keys(mesh, mk, {"file", "physical", "order"});
       const std::filesystem::path f = r.string(mesh["file"], mk + ".file");
       body.mesh_file = (f.is_absolute() ? f : scene_dir / f).string();
@@ -546,8 +604,9 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
     }
     s.bodies.push_back(body);
   }
+  const auto first_solid = std::find_if(s.bodies.begin(), s.bodies.end(), [](const BodySpec& b) { return !b.shell; });
   for (const auto& b : s.bodies)
-    if (b.mesh_file.empty() && b.shape.order != s.bodies[0].shape.order)
+    if (b.mesh_file.empty() && !b.shell && b.shape.order != first_solid->shape.order)
       r.fail(b.key + ".mesh.order", "the same element order for every body");
 
   // A rigid body: its initial velocity prescribed on every node, before any condition.
@@ -604,6 +663,10 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
       else
         load.traction = r.vec3(c["traction"], key + ".traction");
       if (c["amplitude"]) load.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
+      if (s.bodies[load.body].shell)
+        r.fail(key + ".body",
+               "a solid body: '" + s.bodies[load.body].name + "' is a shell (loads on shells are not supported yet)",
+               c["body"]);
       s.loads.push_back(load);
     }
   }
@@ -678,6 +741,9 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
           r.fail("contact.pairs",
                  "the free rigid bodies '" + s.bodies[a].name + "' and '" + s.bodies[b].name +
                      "' may touch; list the pairs that touch without theirs (DCR moves one rigid body per pair)");
+    for (const BodySpec& b : s.bodies)
+      if (b.shell)
+        r.fail("contact", "expected no contact block: body '" + b.name + "' is a shell (shells are not in contact yet)");
     s.contact = cs;
   }
   if (root["gravity"]) s.gravity = r.vec3(root["gravity"], "gravity");

@@ -13,6 +13,7 @@
 #include "kernels/dcr.hpp"
 #include "kernels/types.hpp"
 #include "mesh/gmsh_input.hpp"
+#include "mesh/shell_gmsh.hpp"
 #include "runtime/regions.hpp"
 
 namespace shatter {
@@ -33,6 +34,13 @@ struct MaterialSpec {
   std::optional<FractureSpec> fracture;
 };
 
+/// bodies[i].shell: the body is a thin shell (docs/shells.md): its mesh is the
+/// control mesh of its mid-surface, meshed from `shape` (mesh.shape).
+struct ShellSpec {
+  double thickness = 0;  ///< m
+  ShellShapeSpec shape;  ///< the mid-surface: sphere (its surface), disk, rectangle, cylinder (its side)
+};
+
 struct BodySpec {
   std::string name;
   int material = 0;            ///< index into Scene::materials
@@ -42,6 +50,8 @@ struct BodySpec {
   Vec3 initial_velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Mat3> velocity_gradient;
+  /// bodies[i].shell: a thin shell (its ShapeSpec `shape` is unused); none: a solid.
+  std::optional<ShellSpec> shell;
   /// bodies[i].rigid: true: the body moves with its initial velocity for ever (a condition
   /// "bodies[i].rigid" prescribing it on every node, first in Scene::boundary_conditions),
   /// spinning at angular_velocity about its centre of mass (runtime/rigid_bodies.hpp places
@@ -119,6 +129,11 @@ struct Scene {
   Vec3 gravity = Vec3::Zero();
   std::optional<CheckpointSpec> checkpoint;
 
+  bool has_shells() const {
+    for (const auto& b : bodies)
+      if (b.shell) return true;
+    return false;
+  }
   bool fracture_enabled() const {
     for (const auto& m : materials)
       if (m.fracture) return true;

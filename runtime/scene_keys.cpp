@@ -125,7 +125,19 @@ std::string physics_keys(const Scene& s) {
   for (const BodySpec& b : s.bodies) {
     w.text(b.key + ".name", b.name);
     w.text(b.key + ".material", s.materials[b.material].name);
-    if (b.mesh_file.empty())
+    if (b.shell) {
+      const ShellShapeSpec& m = b.shell->shape;
+      const std::string mk = b.key + ".mesh";
+      w.number(b.key + ".shell.thickness", b.shell->thickness);
+      w.text(mk + ".shape", m.shape);
+      w.number(mk + ".radius", m.radius);
+      w.number(mk + ".length", m.length);
+      w.number(mk + ".width", m.width);
+      w.number(mk + ".height", m.height);
+      w.vec3(mk + ".center", m.center);
+      w.vec3(mk + ".axis", m.axis);
+      w.number(mk + ".element_size", m.element_size);
+    } else if (b.mesh_file.empty())
       shape_keys(w, b.shape, b.key + ".mesh");
     else
       w.text(b.key + ".mesh.physical", b.mesh_physical);

@@ -37,6 +37,7 @@ Simulation::Simulation(Model& model, RunOptions options)
       dec_(std::make_unique<Decomposition>(model, opt_.ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF)),
       elements_(model) {
   const Mesh& mesh = model_.mesh;
+  if (!model_.shells.empty()) shells_ = std::make_unique<ShellForces>(model_);
   model_fingerprint_ = whole_fingerprint(model_);
   if (dec_->distributed()) {
     // The ranks' models must be one: the CLI builds them from rank 0's mesh
@@ -100,7 +101,10 @@ double Simulation::next_dt() {
 void Simulation::compute_forces(long step, double time, const std::function<void()>& between) {
   // `between` (the end of the ghost update) is timed as communication.
   const double comm_before = comm_seconds_;
-  timed(element_seconds_, [&] { last_elements_ = elements_.compute(x_, f_int_, stress6_, between); });
+  timed(element_seconds_, [&] {
+    last_elements_ = elements_.compute(x_, f_int_, stress6_, between);
+    if (shells_) last_shells_ = shells_->compute(x_, f_int_);
+  });
   element_seconds_ -= comm_seconds_ - comm_before;
   // The cohesive elements' nodes are held here and current (the ghost update
   // brings them: Decomposition::rebuild_nodes' groups); update_ledger sums
@@ -108,7 +112,7 @@ void Simulation::compute_forces(long step, double time, const std::function<void
   if (fracture_) cohesive_energy_ = fracture_->add_forces(x_, f_int_);
   // With cohesive elements the stable step also bounds their stiffness:
   // 2 / sqrt(omega_e^2 + lambda_c), both over the whole model.
-  double dt_bound[2] = {last_elements_.stable_dt, fracture_ ? -fracture_->eigenvalue_bound(model_.mass) : 0.0};
+  double dt_bound[2] = {std::min(last_elements_.stable_dt, last_shells_.stable_dt), fracture_ ? -fracture_->eigenvalue_bound(model_.mass) : 0.0};
   dec_->min(dt_bound);
   const double omega_e = 2.0 / dt_bound[0];
   stable_dt_ = fracture_ && fracture_->cohesive_count() > 0 ? 2.0 / std::sqrt(omega_e * omega_e - dt_bound[1])
@@ -424,6 +428,7 @@ void Simulation::update_ledger() {
   std::array<ExactSum, kSums> t;
   std::copy(nodes.begin(), nodes.end(), t.begin());
   for (Index gr : dec_->owned_granules()) t[kStrain] += elements_.granule_energy(gr);
+  t[kStrain] += last_shells_.strain_energy;
   t[kStored] = cohesive_energy_.stored;
   t[kDissipated] = cohesive_energy_.dissipated;
   std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);

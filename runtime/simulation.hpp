@@ -29,6 +29,7 @@
 #include "kernels/rigid_body.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/ledger.hpp"
+#include "runtime/shell_forces.hpp"
 #include "runtime/model.hpp"
 #include "runtime/step_control.hpp"
 
@@ -236,6 +237,8 @@ class Simulation {
   long step_ = 0;
   Ledger ledger_;
   ElementLoopResult last_elements_;
+  std::unique_ptr<ShellForces> shells_;  ///< null without shell bodies
+  ShellLoopResult last_shells_;
   double element_seconds_ = 0;
   double comm_seconds_ = 0;  ///< in MPI exchanges of the step (ghosts, shared nodes, granule sums)
   /// inserting cohesive elements (splits, numbering, node lists): wall and thread CPU time

@@ -54,6 +54,44 @@ void Simulation::write_outputs(bool fields) {
   if (fields && fields_) write_fields(frags ? frags->elem_fragment : std::span<const Index>{});
 }
 
+namespace {
+
+/// The shells' mid-surface at positions x and velocities v (one rank): the
+/// control triangles, their corners on the limit surface (ShellBody::limit_*)
+/// and the triangles' resultants, body after body.
+ShellFrame shell_frame(const Model& model, std::span<const Vec3> x, std::span<const Vec3> v,
+                       const ShellForces* forces) {
+  ShellFrame out;
+  for (const ShellBody& sb : model.shells) {
+    const Index row0 = static_cast<Index>(out.reference.size());
+    for (const auto& t : sb.mesh.triangles) {
+      out.triangles.push_back({row0 + t[0], row0 + t[1], row0 + t[2]});
+      out.body.push_back(sb.body);
+    }
+    for (Index p = 0; p < sb.mesh.num_vertices(); ++p) {
+      Vec3 du = Vec3::Zero(), dv = Vec3::Zero();
+      for (Index k = sb.limit_offsets[p]; k < sb.limit_offsets[p + 1]; ++k) {
+        const Index i = sb.first_node + sb.limit_vertex[k];
+        du += sb.limit_weight[k] * (x[i] - model.mesh.reference[i]);
+        dv += sb.limit_weight[k] * v[i];
+      }
+      out.reference.push_back(sb.limit_reference[p]);
+      out.displacement.push_back(du);
+      out.velocity.push_back(dv);
+    }
+  }
+  if (forces)
+    for (const ShellResultants& r : forces->resultants(x))
+      for (int c = 0; c < 6; ++c) {
+        constexpr int row[6] = {0, 1, 2, 1, 0, 0}, col[6] = {0, 1, 2, 2, 2, 1};  // Voigt xx yy zz yz xz xy
+        out.membrane_force.push_back(r.n(row[c], col[c]));
+        out.bending_moment.push_back(r.m(row[c], col[c]));
+      }
+  return out;
+}
+
+}  // namespace
+
 void Simulation::write_fields(std::span<const Index> elem_fragment) {
   // Each rank packs its owned nodes and elements; the rows move to
   // contiguous blocks in global order (row_blocks.hpp), which each rank
@@ -130,6 +168,8 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   f.body = body;
   f.fragment = fragment;
   f.damage = block_damage;
+  const ShellFrame shells = shell_frame(model_, x_, v_, shells_.get());
+  if (shells_) f.shells = &shells;
   fields_->write(block, f);
 }
 
@@ -178,7 +218,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("element_loop_time", element_seconds_);
   // element-steps per second per core spent in the element loop (the elements computed: not rigid bodies')
   j.add("element_updates_per_second",
-        element_seconds_ > 0 ? double(elements_.computed_elements()) * (step_ + 1) / (element_seconds_ * opt_.threads)
+        element_seconds_ > 0 ? double(elements_.computed_elements() + (shells_ ? shells_->elements() : 0)) * (step_ + 1) / (element_seconds_ * opt_.threads)
                              : 0.0);
   j.add("peak_memory_bytes", peak_memory_bytes());
   j.add("peak_memory_bytes_per_rank", memory.first);

@@ -2,11 +2,11 @@
 // lumped mass, affine patch test, free rigid motion, a dilatational wave, and
 // bitwise determinism across thread counts.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 
 #include "expect_close.hpp"
+#include "run_checks.hpp"
 #include "runtime/model.hpp"
 #include "runtime/simulation.hpp"
 #include "scene_text.hpp"
@@ -158,25 +158,12 @@ TEST(Simulation, DilatationalWaveSpeedAndStress) {
 
 // Same input, any thread count: the same bits.
 TEST(Simulation, BitwiseIdenticalForThreads124) {
-  std::vector<std::vector<Vec3>> results;
-  std::vector<double> energies;
-  for (int threads : {1, 2, 4}) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    Model m = build_model(scene_from_text(
-        "det", body_scene("det", "shape: cylinder, radius: 0.01, length: 0.04, element_size: 0.003", 1,
-                          "    initial_velocity: [3, -1, 2]\n"
-                          "    velocity_gradient: [[300, 50, 0], [0, -200, 80], [10, 0, 100]]\n"
-                          "    angular_velocity: [200, 500, -300]\n")));
-    Simulation sim(m, {});
-    for (int s = 0; s < 100; ++s) sim.step();
-    results.emplace_back(sim.positions().begin(), sim.positions().end());
-    energies.push_back(sim.ledger().total());
-  }
-  for (size_t k = 1; k < results.size(); ++k) {
-    EXPECT_EQ(energies[k], energies[0]);
-    ASSERT_EQ(results[k].size(), results[0].size());
-    EXPECT_EQ(0, std::memcmp(results[k].data(), results[0].data(), results[0].size() * sizeof(Vec3)));
-  }
+  shatter::test::expect_same_bits_for_threads(
+      scene_from_text("det", body_scene("det", "shape: cylinder, radius: 0.01, length: 0.04, element_size: 0.003", 1,
+                                        "    initial_velocity: [3, -1, 2]\n"
+                                        "    velocity_gradient: [[300, 50, 0], [0, -200, 80], [10, 0, 100]]\n"
+                                        "    angular_velocity: [200, 500, -300]\n")),
+      100);
 }
 
 // The step controller (StepControl, docs/physics.md "Step control"): never above
