@@ -38,9 +38,10 @@ NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part) {
 
 std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed) {
   const Index ne = mesh.num_elements(), ng = (ne + granule - 1) / granule;
+  // One part takes every granule, none included (a model of shells alone).
+  if (parts == 1) return std::vector<int>(ng, 0);
   SHATTER_REQUIRE(parts >= 1 && parts <= ng, "partition_granules: cannot cut " << ng << " granules into " << parts
                                                                                 << " parts");
-  if (parts == 1) return std::vector<int>(ng, 0);
   // Edges: granule pairs sharing a node, weighted by the number of shared nodes.
   std::vector<std::pair<idx_t, idx_t>> pairs;
   std::vector<idx_t> star;

@@ -20,7 +20,7 @@ namespace shatter {
 /// the node -> element CSR. For parts = 1 all zeros, without calling METIS.
 /// No part is empty (a part METIS leaves empty takes a granule of the
 /// largest). Layout: part[g] in [0, parts) for granule g.
-/// Throws Error when parts < 1 or parts > granules.
+/// Throws Error when parts < 1, or parts > 1 and parts > granules.
 std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed = 1);
 
 /// CSR of the sorted, distinct parts of the elements around each node

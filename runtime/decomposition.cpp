@@ -29,10 +29,7 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
     granule_rank_ = model.part.granule_rank;
   } else {
     check_ranks(model, size_);
-    granule_rank_ = size_ == 1 ? std::vector<int>((mesh.num_elements() + ElementForces::kGranule - 1) /
-                                                      ElementForces::kGranule,
-                                                  0)
-                               : partition_granules(mesh, ElementForces::kGranule, size_);
+    granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
   }
   // Shell nodes (on one rank, model.cpp): granules of their own, past the elements'.
   first_shell_granule_ = num_granules();
