@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <iomanip>
 #include <sstream>
 
@@ -52,8 +53,10 @@ void check_estimate(const Scene& scene, double max_elements) {
 /// Every body meshed (or read) and checked, appended in order, the elements
 /// along a space-filling curve; `groups` receives each body's physical groups
 /// (mesh files), their node ids shifted as append_mesh shifts the body's.
-Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vector<PhysicalGroup>>& groups) {
+Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vector<PhysicalGroup>>& groups,
+                 double& seconds) {
   check_estimate(scene, max_elements);
+  const auto t0 = std::chrono::steady_clock::now();
   Mesh mesh;
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
@@ -80,6 +83,7 @@ Mesh mesh_bodies(const Scene& scene, double max_elements, std::vector<std::vecto
   // element loop needs consecutive elements to share nodes (3x faster than
   // Gmsh's order, and 15 colors instead of 280; docs/performance.md).
   reorder_for_locality(mesh, GlobalIdPolicy::keep);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return mesh;
 }
 
@@ -171,20 +175,21 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
   if (comm != MPI_COMM_SELF) MPI_Comm_size(comm, &ranks);
   std::vector<std::vector<PhysicalGroup>> groups;
   RegionSelection selection;
+  double mesh_seconds = 0;
   if (ranks > 1 && scene.has_shells())
     for (const BodySpec& b : scene.bodies)
       if (b.shell)
         throw InputError(scene.file + ": " + b.key + ".shell: shells run on one MPI rank (" + std::to_string(ranks) +
                          " here; their parts and 2-ring ghost layer are not built yet); expected mpirun -np 1");
   if (ranks == 1) {
-    m.mesh = mesh_bodies(scene, max_elements, groups);
+    m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds);
     m.shells = add_shell_bodies(scene, m.mesh);
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
   } else if (scene.fracture_enabled() && scene.contact) {
     // Cracks in contact still need the whole model on every rank (docs/parallel.md "Limits").
     on_root(comm, [&] {
-      m.mesh = mesh_bodies(scene, max_elements, groups);
+      m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds);
       selection = select_regions(scene, m.mesh, groups);
     });
     broadcast_mesh(m.mesh, 0, comm);
@@ -192,12 +197,13 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
     complete_model(m, selection);
   } else {
     on_root(comm, [&] {
-      m.mesh = mesh_bodies(scene, max_elements, groups);
+      m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds);
       complete_model(m, select_regions(scene, m.mesh, groups));
       check_ranks(m, ranks);
     });
     distribute_parts(m, comm);
   }
+  m.mesh_seconds = mesh_seconds;
   return m;
 }
 

@@ -57,6 +57,10 @@ struct Model {
   /// no element of `mesh`. Only on a whole model (shells run on one rank).
   std::vector<ShellBody> shells;
 
+  /// Wall seconds the start-up rank spent meshing (Gmsh) or reading the bodies
+  /// and ordering their elements (summary.json mesh_time); 0 on the other ranks.
+  double mesh_seconds = 0;
+
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
   /// its owned elements and their ghost layer, ascending in the whole
   /// model's order, and the nodes they use (with contact, and the contact

@@ -35,9 +35,11 @@ TEST(SurfaceLoad, FlatFaceResultants) {
     sum = Vec3::Zero();
     for (int a = 0; a < nodes; ++a) sum += f[a];
     EXPECT_LT((sum - area.norm() * t).norm(), 1e-14 * area.norm() * t.norm()) << nodes << " nodes";
-    if (nodes == 6)
-      for (int a = 0; a < 6; ++a)  // the 6-node face's shares: 0 at corners, 1/3 at mid-edge nodes
+    if (nodes == 6) {
+      for (int a = 0; a < 6; ++a) {  // the 6-node face's shares: 0 at corners, 1/3 at mid-edge nodes
         EXPECT_LT((f[a] - (a < 3 ? 0.0 : area.norm() / 3) * t).norm(), 1e-14 * area.norm() * t.norm()) << a;
+      }
+    }
   }
 }
 

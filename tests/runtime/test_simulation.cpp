@@ -3,6 +3,7 @@
 // bitwise determinism across thread counts.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "expect_close.hpp"
@@ -36,6 +37,17 @@ TEST(Model, LumpedMassSumsToRhoV) {
     EXPECT_CLOSE(total, 7850 * volume, 1e-13, 0) << "order " << order;
     EXPECT_CLOSE(m.body_mass[0], total, 1e-13, 0);
   }
+}
+
+// summary.json mesh_time: the start-up's meshing, timed inside the model's build.
+TEST(Model, MeshTimeIsPartOfTheBuild) {
+  const Scene scene = scene_from_text(
+      "mesh_time", body_scene("mesh_time", "shape: cylinder, radius: 0.01, length: 0.05, element_size: 0.004", 1, ""));
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model m = build_model(scene);
+  const double build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GT(m.mesh_seconds, 0.0);
+  EXPECT_LT(m.mesh_seconds, build);
 }
 
 // Affine patch test: every boundary node driven with v = L X (constant), the
