@@ -316,6 +316,40 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::v
   return true;
 }
 
+/// Two lattice patches (regular or boundary) on either side of an edge
+/// share the 10 lattice points whose basis functions reach the edge (the
+/// others' vanish there with their first and second derivatives): the patches
+/// meet with their tangent planes when those are the same 10 entries. Where
+/// ghosts chosen in each patch disagree (a boundary that is not straight in
+/// the lattice, as Gmsh's unstructured ones), the boundary patches become
+/// unsupported_boundary.
+void drop_nonconforming_patches(ShellMesh& m, const std::unordered_map<EdgeKey, std::vector<Index>>& edge_triangles) {
+  auto lattice = [&](Index t) {
+    return m.patch_kind[t] == ShellPatchKind::regular || m.patch_kind[t] == ShellPatchKind::boundary;
+  };
+  std::vector<char> drop(m.num_triangles(), 0);
+  for (const auto& [key, tris] : edge_triangles) {
+    if (tris.size() != 2 || !lattice(tris[0]) || !lattice(tris[1])) continue;
+    std::array<Index, 12> a, b;
+    std::copy_n(m.patch_of(tris[0]), 12, a.begin());
+    std::copy_n(m.patch_of(tris[1]), 12, b.begin());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    std::array<Index, 12> common;
+    if (std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), common.begin()) - common.begin() == 10) continue;
+    for (const Index t : tris) drop[t] = m.patch_kind[t] == ShellPatchKind::boundary;
+  }
+  std::vector<Index> patch;
+  std::vector<Index> offsets(1, 0);
+  for (Index t = 0; t < m.num_triangles(); ++t) {
+    if (drop[t]) m.patch_kind[t] = ShellPatchKind::unsupported_boundary;
+    else patch.insert(patch.end(), m.patch_of(t), m.patch_of(t) + m.patch_size(t));
+    offsets.push_back(static_cast<Index>(patch.size()));
+  }
+  m.patch = std::move(patch);
+  m.patch_offsets = std::move(offsets);
+}
+
 }  // namespace
 
 ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Index, 3>> triangles,
@@ -420,6 +454,7 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
     }
     m.patch_offsets.push_back(static_cast<Index>(m.patch.size()));
   }
+  drop_nonconforming_patches(m, edge_triangles);
   resolve_ghosts(m);
   return m;
 }

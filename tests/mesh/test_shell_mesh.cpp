@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <iostream>
 #include <numbers>
 
@@ -395,7 +396,50 @@ TEST(ShellMesh, GmshOpenSurfacesHaveBoundaries) {
       boundary_triangles += touches;
     }
     std::cout << shape << ": " << supported << " of " << boundary_triangles
-              << " boundary triangles completed by ghost vertices\n";
+              << " boundary triangles completed by ghost vertices";
+    // After the runtime's Loop step every triangle has its patch, and the
+    // ghost-completed ones meet their neighbours with the same limit point
+    // and tangent plane at the middle of each shared edge.
+    const ShellMesh fine = loop_subdivide(m, shape);
+    const auto basis = [](double v, double w) {  // N, dN/dv, dN/dw
+      Eigen::Matrix<double, 12, 3> b;
+      const auto l = loop_regular_basis(v, w);
+      b << l.N, l.d1, l.d2;
+      return b;
+    };
+    std::map<std::pair<Index, Index>, std::pair<Index, int>> first;  // edge -> (triangle, its edge k)
+    int checked = 0;
+    double worst_point = 0, worst_normal = 0;
+    for (Index t = 0; t < fine.num_triangles(); ++t) {
+      ASSERT_GT(fine.patch_size(t), 0) << shape << " triangle " << t;
+      if (fine.patch_kind[t] != ShellPatchKind::boundary && fine.patch_kind[t] != ShellPatchKind::regular) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Index p = fine.triangles[t][k], q = fine.triangles[t][(k + 1) % 3];
+        const auto it = first.find({q, p});
+        if (it == first.end()) {
+          first[{p, q}] = {t, k};
+          continue;
+        }
+        // the middle of edge k of triangle t, in (v, w)
+        auto at = [&](Index u, int e) {
+          constexpr double c[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+          const auto b = basis(0.5 * (c[e][0] + c[(e + 1) % 3][0]), 0.5 * (c[e][1] + c[(e + 1) % 3][1]));
+          Eigen::Matrix<double, 3, 3> x = Eigen::Matrix<double, 3, 3>::Zero();
+          for (int a = 0; a < 12; ++a) x += fine.entry_position(fine.reference, fine.patch_of(u)[a]) * b.row(a);
+          return x;
+        };
+        const auto x1 = at(t, k), x2 = at(it->second.first, it->second.second);
+        const Vec3 n1 = x1.col(1).cross(x1.col(2)).normalized(), n2 = x2.col(1).cross(x2.col(2)).normalized();
+        worst_point = std::max(worst_point, (x1.col(0) - x2.col(0)).norm());
+        worst_normal = std::max(worst_normal, (n1 - n2).norm());
+        ++checked;
+      }
+    }
+    std::cout << "; after one Loop step all " << fine.num_triangles() << " have patches, " << checked
+              << " shared edges of lattice patches: limit points within " << worst_point << " m, normals within "
+              << worst_normal << "\n";
+    EXPECT_LT(worst_point, 1e-14);
+    EXPECT_LT(worst_normal, 1e-12);
   }
   EXPECT_NE(input_error([] {
               mesh_shell_shape({.shape = "cone", .element_size = 0.1}, "bodies[0].mesh");
