@@ -2,8 +2,6 @@
 
 #include <gmsh.h>
 
-#include <algorithm>
-#include <cmath>
 #include <unordered_map>
 
 #include "kernels/error.hpp"
@@ -37,14 +35,7 @@ ShellMesh mesh_shell_shape(const ShellShapeSpec& s, const std::string& where) {
     // has the 3 triangles of the regular lattice (1 or 2 at the corners), so
     // that ghost vertices complete every boundary patch; all diagonals alike,
     // so that every interior vertex has valence 6.
-    gmsh::vectorpair curves;
-    gmsh::model::getEntities(curves, 1);
-    for (const auto& [dim, tag] : curves) {
-      double x0, y0, z0, x1, y1, z1;
-      gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
-      const double length = std::max({x1 - x0, y1 - y0, z1 - z0});
-      gmsh::model::mesh::setTransfiniteCurve(tag, std::max(2, static_cast<int>(std::lround(length / s.element_size)) + 1));
-    }
+    transfinite_curves(s.element_size);
     gmsh::vectorpair faces;
     gmsh::model::getEntities(faces, 2);
     for (const auto& [dim, tag] : faces) gmsh::model::mesh::setTransfiniteSurface(tag, "Left");

@@ -302,8 +302,9 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::v
       const Vec3 first = m.reference[f2] - m.reference[f1];
       for (const auto& [e1, e2] : edges) {
         // Only at a right-angled corner do the two reflections commute (the
-        // patches on either side of an edge then agree): elsewhere (the
-        // 60 and 120 degree corners of a lattice parallelogram) no patch.
+        // patches on either side of an edge then agree); elsewhere (corners
+        // of 60 or 120 degrees) the best single reflection, kept where the
+        // patches agree (drop_nonconforming_patches).
         const Vec3 second = m.reference[e2] - m.reference[e1];
         if (std::abs(first.dot(second)) < kRightAngle * first.norm() * second.norm())
           consider(composed, {{b->second, 1.0}}, q->second, e1, e2);

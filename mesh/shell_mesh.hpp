@@ -127,7 +127,9 @@ struct ShellMesh {
 /// Build the control mesh from vertex positions and triangles (any
 /// orientation): the triangles are oriented consistently (by the first
 /// triangle, and outward when the surface is closed), then valences,
-/// boundary vertices and patches are found. InputError naming `where` for a
+/// boundary vertices and patches are found (boundary patches whose ghosts
+/// disagree with a neighbour's across an edge are dropped to
+/// unsupported_boundary: docs/shells.md "Ghost vertices"). InputError naming `where` for a
 /// corner index out of range, a triangle with a repeated corner, an edge of
 /// more than two triangles, a vertex whose triangles do not form one fan, a
 /// non-orientable surface or an unused vertex.

@@ -13,6 +13,7 @@
 #include "expect_close.hpp"
 #include "kernels/shell_kl.hpp"
 #include "kernels/loop_extraordinary.hpp"
+#include "mesh/mesh_test_helpers.hpp"
 #include "mesh/shell_gmsh.hpp"
 #include "mesh/shell_mesh.hpp"
 #include "mesh/shell_subdivision.hpp"
@@ -22,20 +23,7 @@ using namespace shatter;
 namespace {
 
 /// n x n vertices on the square [0, a]^2, vertex (i, j) at index i + n j.
-ShellMesh square_plate(int n, double a) {
-  std::vector<Vec3> x;
-  std::vector<std::array<Index, 3>> tris;
-  const double h = a / (n - 1);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) x.emplace_back(i * h, j * h, 0);
-  auto id = [n](int i, int j) { return Index(i + n * j); };
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      tris.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-      tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return build_shell_mesh(std::move(x), std::move(tris), "plate");
-}
+ShellMesh square_plate(int n, double a) { return shatter::test::square_shell_lattice(n, a / (n - 1), "plate"); }
 
 /// The element loop over every triangle with a patch: f(K-sized basis at
 /// the 3 quadrature points, triangle) for each, by the patch's size.
