@@ -3,6 +3,7 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -250,6 +251,17 @@ std::vector<PhysicalGroup> model_physical_groups() {
     out.push_back(std::move(g));
   }
   return out;
+}
+
+void transfinite_curves(double size) {
+  gmsh::vectorpair curves;
+  gmsh::model::getEntities(curves, 1);
+  for (const auto& [dim, tag] : curves) {
+    double x0, y0, z0, x1, y1, z1;
+    gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
+    const double length = std::max({x1 - x0, y1 - y0, z1 - z0});
+    gmsh::model::mesh::setTransfiniteCurve(tag, std::max(2, static_cast<int>(std::lround(length / size)) + 1));
+  }
 }
 
 }  // namespace shatter

@@ -1,7 +1,8 @@
 #pragma once
 // The Gmsh API's one global model, as the mesh readers use it: a session
-// that serialises and resets it, a file opened into it, and the tetrahedra
-// taken out of it. Internal to shatter::mesh (gmsh_input.cpp, mesh_file.cpp).
+// that serialises and resets it, a file opened into it, the tetrahedra
+// taken out of it, and structured curves. Internal to shatter::mesh
+// (gmsh_input.cpp, mesh_file.cpp, shell_gmsh.cpp) and its tests.
 #include <mutex>
 #include <string>
 #include <vector>
@@ -54,6 +55,11 @@ void require_tetrahedra_only(const std::vector<int>& volumes, const std::string&
 /// whose nodes are renumbered densely in order of first use; ids are Gmsh's
 /// tags. InputError when there are none.
 Mesh model_tetrahedra(const std::vector<int>& volumes, int order, int body, int material, const std::string& where);
+
+/// Make every curve of the model transfinite with round(length / size) + 1
+/// nodes (at least 2), length its bounding box's largest side (straight
+/// curves): structured meshes of transfinite surfaces and volumes.
+void transfinite_curves(double size);
 
 /// The named physical groups of the model, of every dimension (unnamed ones
 /// are left out: a scene names its regions).

@@ -30,6 +30,16 @@ ShellMesh mesh_shell_shape(const ShellShapeSpec& s, const std::string& where) {
   gmsh::option::setNumber("Mesh.MeshSizeMin", s.element_size);
   gmsh::option::setNumber("Mesh.MeshSizeMax", s.element_size);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  if (s.shape == "rectangle") {
+    // Structured (docs/shells.md "The control mesh"): every boundary vertex
+    // has the 3 triangles of the regular lattice (1 or 2 at the corners), so
+    // that ghost vertices complete every boundary patch; all diagonals alike,
+    // so that every interior vertex has valence 6.
+    transfinite_curves(s.element_size);
+    gmsh::vectorpair faces;
+    gmsh::model::getEntities(faces, 2);
+    for (const auto& [dim, tag] : faces) gmsh::model::mesh::setTransfiniteSurface(tag, "Left");
+  }
   gmsh::model::mesh::generate(2);
   // The surfaces that make the mid-surface: all of them, except a cylinder's
   // two flat caps.

@@ -88,16 +88,92 @@ class OppositeVertex {
 };
 
 using Lattice = std::array<int, 2>;
+/// A vertex's weights in a ghost's position, ascending by vertex.
+using Terms = std::vector<std::pair<Index, double>>;
+
+/// a + s b, merged by vertex, zeros dropped.
+Terms combine(const Terms& a, const Terms& b, double s) {
+  Terms out;
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && a[i].first < b[j].first)) {
+      out.push_back(a[i++]);
+    } else if (i == a.size() || b[j].first < a[i].first) {
+      out.emplace_back(b[j].first, s * b[j].second);
+      ++j;
+    } else {
+      out.emplace_back(a[i].first, a[i].second + s * b[j].second);
+      ++i, ++j;
+    }
+    if (out.back().second == 0) out.pop_back();
+  }
+  return out;
+}
+
+/// The ghosts' positions as x_g = shift + sum w x (ShellMesh::ghost_offsets
+/// ...), reflection after reflection, each odd or even (ghost_even).
+void resolve_ghosts(ShellMesh& m) {
+  const Index n = m.num_vertices(), ng = m.num_ghosts();
+  std::vector<Terms> terms(ng);
+  m.ghost_shift.assign(ng, Vec3::Zero());
+  auto entry_terms = [&](Index e) { return e < n ? Terms{{e, 1.0}} : terms[e - n]; };
+  auto entry_shift = [&](Index e) { return e < n ? Vec3::Zero() : m.ghost_shift[e - n]; };
+  auto entry_reference = [&](Index e) { return e < n ? m.reference[e] : m.ghost_reference[e - n]; };
+  for (Index g = 0; g < ng; ++g) {
+    const GhostReflection& r = m.ghost_reflection[g];
+    if (m.ghost_even[g]) {
+      terms[g] = entry_terms(r.mirror);
+      m.ghost_shift[g] = entry_shift(r.mirror) + m.ghost_reference[g] - entry_reference(r.mirror);
+      continue;
+    }
+    Terms t;
+    for (const auto& [e, w] : r.foot) {
+      t = combine(t, entry_terms(e), 2 * w);
+      m.ghost_shift[g] += 2 * w * entry_shift(e);
+    }
+    terms[g] = combine(t, entry_terms(r.mirror), -1.0);
+    m.ghost_shift[g] -= entry_shift(r.mirror);
+  }
+  m.ghost_offsets.assign(1, 0);
+  m.ghost_vertex.clear();
+  m.ghost_weight.clear();
+  for (const Terms& t : terms) {
+    for (const auto& [v, w] : t) m.ghost_vertex.push_back(v), m.ghost_weight.push_back(w);
+    m.ghost_offsets.push_back(static_cast<Index>(m.ghost_vertex.size()));
+  }
+}
+
+/// The boundary edges of the control mesh, per vertex: its neighbours along the boundary.
+std::vector<std::vector<Index>> boundary_neighbours(const ShellMesh& m, const OppositeVertex& opp) {
+  std::vector<std::vector<Index>> out(m.num_vertices());
+  for (const auto& c : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Index p = c[k], q = c[(k + 1) % 3];
+      if (opp(q, p) < 0) out[p].push_back(q), out[q].push_back(p);
+    }
+  return out;
+}
+
+/// A ghost's mirror image is across the boundary from it when the offset
+/// between them is normal to the boundary edge: |cos| of their angle, 0 for
+/// a true mirror image. Reflections with a score above this are not mirror
+/// images (e.g. through the corner of a rectangle, diagonally).
+constexpr double kMirrorScore = 0.5;
+/// Two boundary edges meet at a right angle when |cos| of their angle is below this.
+constexpr double kRightAngle = 1e-3;
 
 /// The 12-vertex patch of triangle c (corners 4, 7, 8 = c[0], c[1], c[2])
 /// with a corner on the boundary, completed by ghost vertices, or false.
 /// The fans of the three corners are unfolded onto the regular lattice
 /// (each must fit it: interior corners of valence 6, no overlap); a lattice
-/// point of the patch with no vertex, next to a boundary edge, becomes a
-/// ghost vertex (the candidates are below).
-/// New ghost rules are appended to m.ghost_rule (deduplicated by `ghost_id`).
-bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::array<Index, 3>& c,
-                           std::map<std::array<Index, 3>, Index>& ghost_id, std::array<Index, 12>& patch) {
+/// point P of the patch with no vertex becomes a ghost vertex, the
+/// reflection of a lattice point across the boundary (candidates below),
+/// or at a corner of the boundary, where no single reflection is a mirror
+/// image, the reflection across one edge of a ghost across the other.
+/// New ghosts are appended to m (deduplicated by their weights, `ghost_id`).
+bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::vector<std::vector<Index>>& along,
+                           const std::array<Index, 3>& c, std::map<Terms, Index>& ghost_id,
+                           std::vector<Terms>& ghost_terms, std::array<Index, 12>& patch) {
   // rot60(d): the lattice vector d turned by +60 degrees
   auto rot60 = [](Lattice d) { return Lattice{-d[1], d[0] + d[1]}; };
   auto add = [](Lattice a, Lattice b, int s) { return Lattice{a[0] + s * b[0], a[1] + s * b[1]}; };
@@ -110,9 +186,8 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::a
   place(c[0], {0, 0});
   place(c[1], {1, 0});
   place(c[2], {0, 1});
-  for (int k = 0; k < 3 && flat; ++k) {
-    const Index p = c[k], q = c[(k + 1) % 3];
-    if (!m.on_boundary[p] && m.valence[p] != 6) return false;
+  // The fan of p onto the lattice, from its placed neighbour q.
+  auto unfold = [&](Index p, Index q) {
     // counter-clockwise: triangle (p, prev, r) has r = p + rot60(prev - p)
     Index prev = q;
     for (Index r = opp(p, prev); r >= 0 && r != q && flat; prev = r, r = opp(p, prev))
@@ -121,57 +196,159 @@ bool ghost_completed_patch(ShellMesh& m, const OppositeVertex& opp, const std::a
     prev = q;
     for (Index s = opp(prev, p); s >= 0 && s != q && flat; prev = s, s = opp(prev, p))
       place(s, add(at[prev], rot60(add(at[p], at[prev], -1)), 1));
+  };
+  for (int k = 0; k < 3 && flat; ++k) {
+    if (!m.on_boundary[c[k]] && m.valence[c[k]] != 6) return false;
+    unfold(c[k], c[(k + 1) % 3]);
   }
-  if (!flat) return false;
-  std::map<Lattice, Index> vertex_at;
+  // and the fans of the boundary vertices among them, where the mirror
+  // images of the ghosts lie (the two patches on either side of an edge then
+  // see the same candidates)
+  std::vector<std::pair<Index, Index>> boundary_fans;
   for (const auto& [v, x] : at)
-    if (!vertex_at.emplace(x, v).second) return false;  // the fans overlap: not a flat lattice
+    if (m.on_boundary[v] && v != c[0] && v != c[1] && v != c[2])
+      for (const Index q : along[v])
+        if (at.count(q)) boundary_fans.emplace_back(v, q);
+  for (const auto& [v, q] : boundary_fans)
+    if (flat) unfold(v, q);
+  if (!flat) return false;
+  const Index n = m.num_vertices();
+  std::map<Lattice, Index> entry_at;  // lattice point -> patch entry (vertex, or n + ghost)
+  for (const auto& [v, x] : at)
+    if (!entry_at.emplace(x, v).second) return false;  // the fans overlap: not a flat lattice
+  auto reference = [&](Index e) { return e < n ? m.reference[e] : m.ghost_reference[e - n]; };
+  auto terms_of = [&](Index e) { return e < n ? Terms{{e, 1.0}} : ghost_terms[e - n]; };
+
+  struct Candidate {
+    GhostReflection rule;
+    double score = HUGE_VAL;
+  };
+  // The reflection of `mirror` through `foot` across the boundary edge (b, e),
+  // scored by how nearly it is the ghost's mirror image across that edge.
+  auto consider = [&](Candidate& best, const Terms& foot, Index mirror, Index b, Index e) {
+    Vec3 x_foot = Vec3::Zero();
+    for (const auto& [f, w] : foot) x_foot += w * reference(f);
+    const Vec3 d = reference(mirror) - (2 * x_foot - reference(mirror));
+    const Vec3 edge = m.reference[e] - m.reference[b];
+    const double score = std::abs(d.dot(edge)) / (d.norm() * edge.norm());
+    if (score < best.score - 1e-9) best = {{{std::min(b, e), std::max(b, e)}, foot, mirror}, score};
+  };
+  auto add_ghost = [&](Index a, const GhostReflection& rule) {
+    Terms t;
+    Vec3 x_foot = Vec3::Zero();
+    for (const auto& [f, w] : rule.foot) t = combine(t, terms_of(f), 2 * w), x_foot += w * reference(f);
+    t = combine(t, terms_of(rule.mirror), -1.0);
+    const auto [g, inserted] = ghost_id.try_emplace(t, m.num_ghosts());
+    if (inserted) {
+      m.ghost_reflection.push_back(rule);
+      m.ghost_reference.push_back(2 * x_foot - reference(rule.mirror));
+      m.ghost_even.push_back(0);
+      ghost_terms.push_back(std::move(t));
+    }
+    patch[a] = n + g->second;
+    entry_at[{kLoopRegularLattice[a][0], kLoopRegularLattice[a][1]}] = n + g->second;
+  };
   static constexpr Lattice kAround[6] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
+  std::vector<std::pair<int, Candidate>> corner;  // lattice points left for the corner rule
   for (int a = 0; a < 12; ++a) {
     const Lattice P{kLoopRegularLattice[a][0], kLoopRegularLattice[a][1]};
-    if (const auto it = vertex_at.find(P); it != vertex_at.end()) {
+    if (const auto it = entry_at.find(P); it != entry_at.end()) {
       patch[a] = it->second;
       continue;
     }
-    // Candidates, for each boundary edge (B1, B2) next to P: the reflection
-    // of the edge triangle's third vertex A through the edge's midpoint
-    // (B1 + B2 - A), and of the vertex Q = 2 B - P through either end B
-    // (2 B - Q). All put the ghost on the lattice point; the one whose
-    // partner (A or Q) is the ghost's mirror image across the edge (its
-    // offset most nearly normal to the edge) is taken, so that held
-    // boundary vertices make an odd reflection of the control net.
-    std::array<Index, 3> best{};
-    double best_score = HUGE_VAL;
-    auto consider = [&](const std::array<Index, 3>& rule, Index partner, const Vec3& edge) {
-      const Vec3 ghost = m.reference[rule[0]] + m.reference[rule[1]] - m.reference[rule[2]];
-      const Vec3 d = m.reference[partner] - ghost;
-      const double score = std::abs(d.dot(edge)) / (d.norm() * edge.norm());
-      if (score < best_score - 1e-9) best_score = score, best = rule;
-    };
+    // Candidates: for each boundary edge (B1, B2) next to P, the reflection
+    // of the edge triangle's third vertex A through the edge's midpoint; for
+    // each boundary vertex B next to P, of the vertex Q = 2 B - P through B,
+    // across either boundary edge at B. All put the ghost on the lattice
+    // point; the one whose partner (A or Q) is most nearly the ghost's mirror
+    // image across its edge is taken, so that held boundary vertices make an
+    // odd reflection of the control net.
+    Candidate best;
     for (int k = 0; k < 6; ++k) {
-      const auto b1 = vertex_at.find(add(P, kAround[k], 1)), b2 = vertex_at.find(add(P, kAround[(k + 1) % 6], 1));
-      if (b1 == vertex_at.end() || b2 == vertex_at.end()) continue;
-      const Index B1 = b1->second, B2 = b2->second;
-      const Index A12 = opp(B1, B2), A21 = opp(B2, B1);
+      const auto b1 = entry_at.find(add(P, kAround[k], 1)), b2 = entry_at.find(add(P, kAround[(k + 1) % 6], 1));
+      if (b1 == entry_at.end() || b1->second >= n || !m.on_boundary[b1->second]) continue;
+      const Index B = b1->second;
+      if (const auto q = entry_at.find(add(add(b1->first, b1->first, 1), P, -1)); q != entry_at.end() && q->second < n)
+        for (const Index e : along[B]) consider(best, {{B, 1.0}}, q->second, B, e);
+      if (b2 == entry_at.end() || b2->second >= n) continue;
+      const Index B2 = b2->second, A12 = opp(B, B2), A21 = opp(B2, B);
       if ((A12 >= 0) == (A21 >= 0)) continue;  // not a boundary edge
       const Index A = A12 >= 0 ? A12 : A21;
-      const Vec3 edge = m.reference[B2] - m.reference[B1];
       const Lattice reflected = add(add(b1->first, b2->first, 1), P, -1);
       if (const auto ia = at.find(A); ia == at.end() || ia->second == reflected)
-        consider({std::min(B1, B2), std::max(B1, B2), A}, A, edge);
-      for (const auto& b : {b1, b2})
-        if (const auto q = vertex_at.find(add(add(b->first, b->first, 1), P, -1)); q != vertex_at.end())
-          consider({b->second, b->second, q->second}, q->second, edge);
+        consider(best, {{std::min(B, B2), 0.5}, {std::max(B, B2), 0.5}}, A, B, B2);
     }
-    if (best_score == HUGE_VAL) return false;
-    const auto [g, inserted] = ghost_id.try_emplace(best, static_cast<Index>(m.ghost_rule.size()));
-    if (inserted) {
-      m.ghost_rule.push_back(best);
-      m.ghost_mode.push_back(GhostMode::odd);
+    if (best.score < kMirrorScore)
+      add_ghost(a, best.rule);
+    else
+      corner.emplace_back(a, best);
+  }
+  // At a right-angled corner of the boundary: P = 2 B - Q along a lattice
+  // line, B a ghost and Q a ghost or vertex, across the boundary edge of the
+  // patch most nearly normal to the line and at right angles to B's (the
+  // reflection across the second edge of a ghost across the first).
+  // Without one, the best single reflection.
+  std::vector<std::array<Index, 2>> edges;
+  for (const auto& [v, x] : at)
+    for (const Index e : along[v])
+      if (v < e && at.count(e)) edges.push_back({v, e});
+  for (auto& [a, best] : corner) {
+    const Lattice P{kLoopRegularLattice[a][0], kLoopRegularLattice[a][1]};
+    Candidate composed;
+    for (const Lattice& d : kAround) {
+      const auto b = entry_at.find(add(P, d, 1)), q = entry_at.find(add(P, d, 2));
+      if (b == entry_at.end() || q == entry_at.end() || b->second < n) continue;
+      const auto& [f1, f2] = m.ghost_reflection[b->second - n].edge;
+      const Vec3 first = m.reference[f2] - m.reference[f1];
+      for (const auto& [e1, e2] : edges) {
+        // Only at a right-angled corner do the two reflections commute (the
+        // patches on either side of an edge then agree); elsewhere (corners
+        // of 60 or 120 degrees) the best single reflection, kept where the
+        // patches agree (drop_nonconforming_patches).
+        const Vec3 second = m.reference[e2] - m.reference[e1];
+        if (std::abs(first.dot(second)) < kRightAngle * first.norm() * second.norm())
+          consider(composed, {{b->second, 1.0}}, q->second, e1, e2);
+      }
     }
-    patch[a] = m.num_vertices() + g->second;
+    const Candidate& take = composed.score < kMirrorScore ? composed : best;
+    if (take.score == HUGE_VAL) return false;
+    add_ghost(a, take.rule);
   }
   return true;
+}
+
+/// Two lattice patches (regular or boundary) on either side of an edge
+/// share the 10 lattice points whose basis functions reach the edge (the
+/// others' vanish there with their first and second derivatives): the patches
+/// meet with their tangent planes when those are the same 10 entries. Where
+/// ghosts chosen in each patch disagree (a boundary that is not straight in
+/// the lattice, as Gmsh's unstructured ones), the boundary patches become
+/// unsupported_boundary.
+void drop_nonconforming_patches(ShellMesh& m, const std::unordered_map<EdgeKey, std::vector<Index>>& edge_triangles) {
+  auto lattice = [&](Index t) {
+    return m.patch_kind[t] == ShellPatchKind::regular || m.patch_kind[t] == ShellPatchKind::boundary;
+  };
+  std::vector<char> drop(m.num_triangles(), 0);
+  for (const auto& [key, tris] : edge_triangles) {
+    if (tris.size() != 2 || !lattice(tris[0]) || !lattice(tris[1])) continue;
+    std::array<Index, 12> a, b;
+    std::copy_n(m.patch_of(tris[0]), 12, a.begin());
+    std::copy_n(m.patch_of(tris[1]), 12, b.begin());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    std::array<Index, 12> common;
+    if (std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), common.begin()) - common.begin() == 10) continue;
+    for (const Index t : tris) drop[t] = m.patch_kind[t] == ShellPatchKind::boundary;
+  }
+  std::vector<Index> patch;
+  std::vector<Index> offsets(1, 0);
+  for (Index t = 0; t < m.num_triangles(); ++t) {
+    if (drop[t]) m.patch_kind[t] = ShellPatchKind::unsupported_boundary;
+    else patch.insert(patch.end(), m.patch_of(t), m.patch_of(t) + m.patch_size(t));
+    offsets.push_back(static_cast<Index>(patch.size()));
+  }
+  m.patch = std::move(patch);
+  m.patch_offsets = std::move(offsets);
 }
 
 }  // namespace
@@ -243,7 +420,9 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
   };
   m.patch_kind.resize(nt);
   m.patch_offsets.assign(1, 0);
-  std::map<std::array<Index, 3>, Index> ghost_id;
+  std::map<Terms, Index> ghost_id;
+  std::vector<Terms> ghost_terms;
+  const auto along = boundary_neighbours(m, opp);
   for (Index t = 0; t < nt; ++t) {
     auto& c = m.triangles[t];
     int irregular = 0, first_irregular = 0;
@@ -253,7 +432,7 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
       if (m.valence[c[k]] != 6 && irregular++ == 0) first_irregular = k;
     }
     std::array<Index, 12> completed;
-    if (boundary && ghost_completed_patch(m, opp, c, ghost_id, completed)) {
+    if (boundary && ghost_completed_patch(m, opp, along, c, ghost_id, ghost_terms, completed)) {
       m.patch_kind[t] = ShellPatchKind::boundary;
       m.patch.insert(m.patch.end(), completed.begin(), completed.end());
     } else if (boundary) {
@@ -276,7 +455,17 @@ ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Inde
     }
     m.patch_offsets.push_back(static_cast<Index>(m.patch.size()));
   }
+  drop_nonconforming_patches(m, edge_triangles);
+  resolve_ghosts(m);
   return m;
+}
+
+void clamp_shell_edges(ShellMesh& m, const std::vector<std::uint8_t>& clamped) {
+  for (Index g = 0; g < m.num_ghosts(); ++g) {
+    const auto [a, b] = m.ghost_reflection[g].edge;
+    m.ghost_even[g] = clamped[a] && clamped[b];
+  }
+  resolve_ghosts(m);
 }
 
 }  // namespace shatter

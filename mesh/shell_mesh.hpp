@@ -23,11 +23,13 @@ namespace shatter {
 ///                subdivision of the control mesh separates them); no patch;
 ///  boundary:     a corner on the boundary, the fans of the corners fit the
 ///                regular lattice and every missing lattice point of the
-///                patch is next to a boundary edge: 12 control vertices in
-///                Stam's order, some of them ghost vertices (ghost_rule);
+///                patch is the mirror image of a lattice point across the
+///                boundary (or, at a corner of the boundary, across both of
+///                its edges): 12 control vertices in Stam's order, some of
+///                them ghost vertices (GhostReflection);
 ///  unsupported_boundary: any other triangle with a corner on the boundary
-///                (e.g. at a corner of the boundary, or an extraordinary
-///                vertex next to it); no patch.
+///                (the fans do not fit the lattice, as on unstructured
+///                boundaries, or an extraordinary vertex next to it); no patch.
 enum class ShellPatchKind : std::uint8_t {
   regular,
   extraordinary,
@@ -55,20 +57,32 @@ enum class ShellPatchKind : std::uint8_t {
 ///       across the edge p-[1]); N+1..N+5: Stam's vertices 6, 10, 11, 12, 9
 ///       (beyond corner [1], across the edge [1]-[2], beyond corner [2]).
 ///     boundary: as regular; an entry n + g (n = num_vertices()) is ghost g.
-///   ghost_rule[g] = {b1, b2, a}: ghost vertex g sits at x_b1 + x_b2 - x_a
-///     (ghost vertices as Cirak et al. (2000) use them at boundaries): the
-///     reflection of a through the midpoint of a boundary edge (b1, b2), or
-///     through a boundary vertex b1 = b2, whichever makes a the mirror image
-///     of the ghost across the boundary in the reference configuration; its
-///     force goes to b1 and b2 and, negated, to a, which keeps the sum of
-///     forces and of their moments. With the boundary vertices held, the
-///     edge is simply supported; free otherwise (docs/shells.md).
-///   ghost_mode[g]: odd (the rule above) or even: the ghost moves with a,
-///     x_g = x_a + (X_b1 + X_b2 - 2 X_a) with X the reference positions, its
-///     force going to a alone. Even ghosts with the boundary vertices held
-///     make a clamped edge (zero slope across it); they keep the sum of
-///     forces but not of moments, as a clamp does not.
-enum class GhostMode : std::uint8_t { odd, even };
+///   ghost g (0 <= g < num_ghosts()): a lattice point of a boundary patch
+///     outside the surface (Cirak et al. (2000) use such ghost vertices at
+///     boundaries), built as ghost_reflection[g] (below) and evaluated as
+///     x_g = ghost_shift[g] + sum_k ghost_weight[k] x[ghost_vertex[k]], k in
+///     [ghost_offsets[g], ghost_offsets[g+1]) (CSR over vertices, ascending).
+///     Its force (or lumped mass) goes to those vertices with those weights.
+///     ghost_reference[g]: its reference position X_g, m; ghost_even[g]: 1 when
+///     its reflection is even (set by clamp_shell_edges).
+
+/// How ghost vertex g is made (docs/shells.md "Ghost vertices"): the mirror
+/// image of patch entry `mirror` (a vertex, or n + an earlier ghost) across
+/// the boundary edge (edge[0], edge[1]), through `foot`, a point on the
+/// boundary given as patch entries and weights summing to 1.
+///   odd (default):  x_g = 2 x_foot - x_mirror, a linear extrapolation of the
+///     control net across the boundary; with the boundary vertices held,
+///     w_g = -w_mirror: zero moment at the edge (simply supported);
+///   even (the edge clamped): x_g = x_mirror + (X_g - X_mirror): the ghost
+///     moves with its mirror image, zero slope across the edge.
+/// At a corner of the boundary a ghost is the reflection of a ghost across
+/// the other edge (foot and mirror ghosts themselves): both reflections
+/// composed, so w is even about the corner of a simply supported plate.
+struct GhostReflection {
+  std::array<Index, 2> edge;
+  std::vector<std::pair<Index, double>> foot;
+  Index mirror = 0;
+};
 
 struct ShellMesh {
   std::vector<Vec3> reference;
@@ -78,11 +92,16 @@ struct ShellMesh {
   std::vector<ShellPatchKind> patch_kind;
   std::vector<Index> patch_offsets;
   std::vector<Index> patch;
-  std::vector<std::array<Index, 3>> ghost_rule;
-  std::vector<GhostMode> ghost_mode;
+  std::vector<GhostReflection> ghost_reflection;
+  std::vector<Vec3> ghost_reference;
+  std::vector<std::uint8_t> ghost_even;
+  std::vector<Index> ghost_offsets{0}, ghost_vertex;
+  std::vector<double> ghost_weight;
+  std::vector<Vec3> ghost_shift;
 
   Index num_vertices() const { return static_cast<Index>(reference.size()); }
   Index num_triangles() const { return static_cast<Index>(triangles.size()); }
+  Index num_ghosts() const { return static_cast<Index>(ghost_reference.size()); }
   const Index* patch_of(Index t) const { return patch.data() + patch_offsets[t]; }
   Index patch_size(Index t) const { return patch_offsets[t + 1] - patch_offsets[t]; }
 
@@ -90,9 +109,9 @@ struct ShellMesh {
   Vec3 entry_position(std::span<const Vec3> x, Index id) const {
     if (id < num_vertices()) return x[id];
     const Index g = id - num_vertices();
-    const auto& [b1, b2, a] = ghost_rule[g];
-    if (ghost_mode[g] == GhostMode::even) return x[a] + (reference[b1] + reference[b2] - 2.0 * reference[a]);
-    return x[b1] + x[b2] - x[a];
+    Vec3 p = ghost_shift[g];
+    for (Index k = ghost_offsets[g]; k < ghost_offsets[g + 1]; ++k) p += ghost_weight[k] * x[ghost_vertex[k]];
+    return p;
   }
 
   /// Call add(vertex, weight) for the vertices patch entry `id` stands for:
@@ -101,22 +120,27 @@ struct ShellMesh {
   void scatter_entry(Index id, Add&& add) const {
     if (id < num_vertices()) return add(id, 1.0);
     const Index g = id - num_vertices();
-    const auto& [b1, b2, a] = ghost_rule[g];
-    if (ghost_mode[g] == GhostMode::even) return add(a, 1.0);
-    add(b1, 1.0);
-    add(b2, 1.0);
-    add(a, -1.0);
+    for (Index k = ghost_offsets[g]; k < ghost_offsets[g + 1]; ++k) add(ghost_vertex[k], ghost_weight[k]);
   }
 };
 
 /// Build the control mesh from vertex positions and triangles (any
 /// orientation): the triangles are oriented consistently (by the first
 /// triangle, and outward when the surface is closed), then valences,
-/// boundary vertices and patches are found. InputError naming `where` for a
+/// boundary vertices and patches are found (boundary patches whose ghosts
+/// disagree with a neighbour's across an edge are dropped to
+/// unsupported_boundary: docs/shells.md "Ghost vertices"). InputError naming `where` for a
 /// corner index out of range, a triangle with a repeated corner, an edge of
 /// more than two triangles, a vertex whose triangles do not form one fan, a
 /// non-orientable surface or an unused vertex.
 ShellMesh build_shell_mesh(std::vector<Vec3> points, std::vector<std::array<Index, 3>> triangles,
                            const std::string& where);
+
+/// Clamp the boundary edges whose two vertices have clamped[v] != 0: the
+/// ghosts reflected across them become even (GhostReflection), all others
+/// odd; the ghosts' weights are recomputed. With those vertices held, the
+/// edges are clamped (docs/shells.md). Even ghosts keep the sum of forces
+/// but not of moments, as a clamp does not.
+void clamp_shell_edges(ShellMesh& m, const std::vector<std::uint8_t>& clamped);
 
 }  // namespace shatter

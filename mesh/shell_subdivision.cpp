@@ -29,20 +29,22 @@ ShellMesh loop_subdivide(const ShellMesh& m, const std::string& where) {
       else
         edges[it->second].opposite[1] = c[(k + 2) % 3];
     }
-  // vertex rule: sums over the neighbours (all, and those along the boundary)
-  std::vector<Vec3> ring_sum(n, Vec3::Zero()), boundary_sum(n, Vec3::Zero());
+  // vertex rule: the sum over the neighbours, and the neighbours along the boundary
+  std::vector<Vec3> ring_sum(n, Vec3::Zero());
+  std::vector<std::vector<Index>> along(n);
   for (const Edge& e : edges) {
     ring_sum[e.a] += m.reference[e.b];
     ring_sum[e.b] += m.reference[e.a];
-    if (e.opposite[1] < 0) {
-      boundary_sum[e.a] += m.reference[e.b];
-      boundary_sum[e.b] += m.reference[e.a];
-    }
+    if (e.opposite[1] < 0) along[e.a].push_back(e.b), along[e.b].push_back(e.a);
   }
   std::vector<Vec3> x(n + edges.size());
   for (Index v = 0; v < n; ++v) {
     if (m.on_boundary[v]) {
-      x[v] = 0.75 * m.reference[v] + 0.125 * boundary_sum[v];
+      // Hoppe et al. (SIGGRAPH 1994): a corner of the boundary (it turns by
+      // more than kCornerTurn) stays; elsewhere the cubic B-spline rule.
+      const Vec3 X = m.reference[v], in = X - m.reference[along[v][0]], out = m.reference[along[v][1]] - X;
+      const bool corner = in.dot(out) < std::cos(kCornerTurn) * in.norm() * out.norm();
+      x[v] = corner ? X : Vec3(0.75 * X + 0.125 * (m.reference[along[v][0]] + m.reference[along[v][1]]));
       continue;
     }
     const int N = m.valence[v];

@@ -114,10 +114,6 @@ std::string describe(const RegionSpec& r) {
   return "";
 }
 
-bool in_box(const RegionSpec& r, const Vec3& X) {
-  return (X.array() >= r.lo.array()).all() && (X.array() <= r.hi.array()).all();
-}
-
 }  // namespace
 
 std::vector<std::string> shape_face_names(const ShapeSpec& shape) {
@@ -161,7 +157,7 @@ std::vector<BoundaryFace> region_faces(const RegionContext& c, const RegionSpec&
     bool hit = false;
     switch (r.kind) {
       case RegionSpec::Kind::box:
-        hit = in_box(r, X[0]) && in_box(r, X[1]) && in_box(r, X[2]);
+        hit = r.box_holds(X[0]) && r.box_holds(X[1]) && r.box_holds(X[2]);
         break;
       case RegionSpec::Kind::physical: {
         std::array<GlobalId, 3> t = {mesh.node_gid[n[local[0]]], mesh.node_gid[n[local[1]]], mesh.node_gid[n[local[2]]]};
@@ -193,7 +189,7 @@ std::vector<Index> region_nodes(const RegionContext& c, const RegionSpec& r) {
   std::vector<Index> out;
   if (r.kind == RegionSpec::Kind::box) {
     for (Index i = 0; i < mesh.num_nodes(); ++i)
-      if (mesh.node_body[i] == c.body && in_box(r, mesh.reference[i])) out.push_back(i);
+      if (mesh.node_body[i] == c.body && r.box_holds(mesh.reference[i])) out.push_back(i);
     if (out.empty())
       throw InputError(c.where + ": the box holds no node of body '" + c.body_name +
                        "'; expected a box around some of its nodes");

@@ -18,6 +18,8 @@ struct RegionSpec {
   Kind kind = Kind::box;
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  ///< box corners, m (reference coordinates, inclusive)
   std::string name;                           ///< physical group or face name
+  /// A box region holds X when X is inside it, bounds included.
+  bool box_holds(const Vec3& X) const { return (X.array() >= lo.array()).all() && (X.array() <= hi.array()).all(); }
 };
 
 /// The face names of a primitive shape: box xmin..zmax; cylinder top, bottom,

@@ -626,7 +626,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
       const std::string key = "boundary_conditions[" + std::to_string(i) + "]";
       const YAML::Node c = bcs[i];
       BoundaryConditionSpec bc = read_acting_on<BoundaryConditionSpec>(
-          r, c, key, s, {"body", "region", "velocity", "displacement", "amplitude"});
+          r, c, key, s, {"body", "region", "velocity", "displacement", "amplitude", "clamped"});
       bc.displacement = !read_either(r, c, key, "velocity", "displacement",
                                      "velocity [vx, vy, vz] or displacement [ux, uy, uz]");
       const std::string vk = key + "." + bc.quantity();
@@ -642,6 +642,15 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
         }
       if (!any) r.fail(vk, "at least one prescribed (non-null) component", v);
       if (c["amplitude"]) bc.amplitude = read_amplitude(r, c["amplitude"], key + ".amplitude");
+      if (c["clamped"]) {
+        bc.clamped = r.flag(c["clamped"], key + ".clamped");
+        if (bc.clamped && !s.bodies[bc.body].shell)
+          r.fail(key + ".clamped", "no clamped key for the solid body '" + s.bodies[bc.body].name +
+                                       "' (a clamp turns a shell's edge; a solid's held nodes are clamped already)",
+                 c["clamped"]);
+        if (bc.clamped && !(bc.value[0] && bc.value[1] && bc.value[2]))
+          r.fail(vk, "all three components prescribed on a clamped edge", v);
+      }
       if (s.bodies[bc.body].free_rigid)
         r.fail(key + ".body",
                "a body that is not rigid: free (a free rigid body moves by its momenta; rigid: true prescribes its "

@@ -75,6 +75,9 @@ struct BoundaryConditionSpec {
   bool displacement = false;                   ///< `value` is a displacement (m), else a velocity (m/s)
   std::array<std::optional<double>, 3> value;  ///< prescribed components (null = free), times amplitude(t)
   Amplitude amplitude;
+  /// Shell bodies: the region's boundary edges are clamped (their ghost
+  /// vertices even: zero slope across the edge; docs/shells.md), besides held.
+  bool clamped = false;
   std::string key;
   /// "velocity" or "displacement": the key of the values.
   const char* quantity() const { return displacement ? "displacement" : "velocity"; }

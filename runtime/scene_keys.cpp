@@ -161,6 +161,7 @@ std::string physics_keys(const Scene& s) {
         w.text(key, "null");
     }
     amplitude_keys(w, c.amplitude, c.key + ".amplitude");
+    if (c.clamped) w.text(c.key + ".clamped", "true");
   }
   for (const LoadSpec& l : s.loads) {
     w.text(l.key + ".body", s.bodies[l.body].name);

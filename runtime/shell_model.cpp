@@ -54,6 +54,15 @@ ShellBody build_shell_body(const Scene& scene, int body, const std::string& wher
   ShellShapeSpec coarse = spec.shell->shape;
   coarse.element_size *= 2;
   s.mesh = loop_subdivide(mesh_shell_shape(coarse, where), where);
+  // Clamped boundary conditions: their boxes' control vertices (as
+  // runtime/regions.cpp selects them) clamp the boundary edges between them.
+  std::vector<std::uint8_t> clamped(s.mesh.num_vertices(), 0);
+  bool any_clamped = false;
+  for (const BoundaryConditionSpec& bc : scene.boundary_conditions)
+    if (bc.body == body && bc.clamped)
+      for (Index v = 0; v < s.mesh.num_vertices(); ++v)
+        if (bc.region.box_holds(s.mesh.reference[v])) clamped[v] = 1, any_clamped = true;
+  if (any_clamped) clamp_shell_edges(s.mesh, clamped);
 
   std::vector<std::vector<Index>> by_valence(kShellMaxValence + 1);
   Index missing = 0;
@@ -75,8 +84,10 @@ ShellBody build_shell_body(const Scene& scene, int body, const std::string& wher
   if (missing > 0) {
     std::ostringstream os;
     os << where << ": " << missing << " of " << s.mesh.num_triangles()
-       << " triangles of the shell's control mesh have no Loop patch (at its boundary: boundary corners and "
-          "unstructured boundaries are not supported yet, docs/shells.md); expected a closed surface (sphere)";
+       << " triangles of the shell's control mesh have no Loop patch (at its boundary: a boundary vertex's "
+          "triangles do not fit the regular lattice, or the ghost vertices of the patches on either side of an edge "
+          "disagree; docs/shells.md \"Ghost vertices\"); expected every triangle with its patch (another element_size "
+          "may do)";
     throw InputError(os.str());
   }
   for (int n = kShellMinValence; n <= kShellMaxValence; ++n) {

@@ -52,14 +52,7 @@ std::string write_beam(double L, double h, double size) {
     if (x0 > L * (1 - 1e-3)) gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, {tag}), "tip");
   }
   gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, {v}), "beam");
-  gmsh::vectorpair curves;
-  gmsh::model::getEntities(curves, 1);
-  for (const auto& [dim, tag] : curves) {
-    double x0, y0, z0, x1, y1, z1;
-    gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
-    const double length = std::max({x1 - x0, y1 - y0, z1 - z0});
-    gmsh::model::mesh::setTransfiniteCurve(tag, static_cast<int>(std::lround(length / size)) + 1);
-  }
+  transfinite_curves(size);
   for (const auto& [dim, tag] : faces) gmsh::model::mesh::setTransfiniteSurface(tag);
   gmsh::model::mesh::setTransfiniteVolume(v);
   gmsh::option::setNumber("Mesh.ElementOrder", 2);

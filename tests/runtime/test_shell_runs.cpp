@@ -261,7 +261,7 @@ TEST(ShellRuns, FreeCylinderKeepsMomentaAndEnergy) {
        << "    initial_velocity: [1, 0, 0]\n    angular_velocity: [0, 0, 50]\n"
        << "    velocity_gradient: [[10, 0, 0], [0, 10, 0], [0, 0, 0]]\n";
   Model m = build_model(scene_from_text("shell_cylinder", yaml.str()));
-  ASSERT_GT(m.shells[0].mesh.ghost_rule.size(), 0u);  // the free edges' ghosts are in use
+  ASSERT_GT(m.shells[0].mesh.num_ghosts(), 0);  // the free edges' ghosts are in use
   Simulation sim(m, {});
   const FreeRun r = run_free(m, sim, 600);
   EXPECT_LT((r.P - r.P0).norm(), 1e-13 * r.P0.norm());
