@@ -153,6 +153,57 @@ inline double pair_normal_norm(DcrPairKind kind, const PairPoints& X) {
   return (X.col(1) - X.col(0)).cross(X.col(3) - X.col(2)).norm();
 }
 
+/// The thickness of a pair with a shell among its sides (docs/shells.md "Contact"). A shell's
+/// contact surface is its control mesh, the mid-surface's control net, thickened by its
+/// half-thickness r on both sides; a pair of sides with r_1 and r_2 (0 for a solid) keeps its
+/// points apart by h = r_1 + r_2 along the primitives' common normal n:
+///   g_h(X) = s V(X) - h |n(X)| / 6 = |n| (s d - h) / 6,
+/// d = 6 V / |n| the signed distance of the vertex from the face's plane / of the two edges'
+/// lines. g_h is invariant under translations and rotations of the four points, as V is, so
+/// its impulses keep both momenta exactly. With h = 0 every function below is the solids'.
+struct PairThickness {
+  double reach = 0.0;       ///< h = r_1 + r_2, m
+  bool sheet_face = false;  ///< vertex-face: the face is a shell's, two-sided (s from the side the vertex starts on)
+};
+
+/// grad |n| (m): vertex-face n = e1 x e2 (e1 = b - a, e2 = c - a): d|n|/db = e2 x n^,
+/// d|n|/dc = n^ x e1, d|n|/da = -(both), d|n|/dp = 0; edge-edge n = ea x eb: d|n|/da1 = eb x n^
+/// = -d|n|/da0, d|n|/db1 = n^ x ea = -d|n|/db0. Zero when n = 0.
+inline PairPoints pair_normal_norm_gradient(DcrPairKind kind, const PairPoints& X) {
+  PairPoints G = PairPoints::Zero();
+  if (kind == DcrPairKind::VertexFace) {
+    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), n = e1.cross(e2);
+    const double l = n.norm();
+    if (!(l > 0.0)) return G;
+    const Vec3 u = n / l;
+    G.col(2) = e2.cross(u);
+    G.col(3) = u.cross(e1);
+    G.col(1) = -(G.col(2) + G.col(3));
+    return G;
+  }
+  const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), n = ea.cross(eb);
+  const double l = n.norm();
+  if (!(l > 0.0)) return G;
+  const Vec3 u = n / l;
+  G.col(1) = eb.cross(u);
+  G.col(0) = -G.col(1);
+  G.col(3) = u.cross(ea);
+  G.col(2) = -G.col(3);
+  return G;
+}
+
+/// The constraint g_h = s V - h |n| / 6 of a pair (m^3; PairThickness), s V for h = 0.
+inline double pair_gap(DcrPairKind kind, double s, double h, const PairPoints& X) {
+  const double g = s * pair_volume(X);
+  return h > 0.0 ? g - h * pair_normal_norm(kind, X) / 6.0 : g;
+}
+
+/// grad g_h (m^2), s grad V for h = 0.
+inline PairPoints pair_gap_gradient(DcrPairKind kind, double s, double h, const PairPoints& X) {
+  const PairPoints G = s * pair_volume_gradient(X);
+  return h > 0.0 ? PairPoints(G - (h / 6.0) * pair_normal_norm_gradient(kind, X)) : G;
+}
+
 /// The touching tolerance on |g| over a step (m^3): kDcrTouchTolerance L |n| / 6 with L
 /// from X_old and the larger |n| of X_old and X_new.
 inline double dcr_touch_tolerance(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
@@ -307,8 +358,13 @@ inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
 /// normals: a callable returning the pair's PairNormals, called only for the few candidates
 /// that pass the cheap tests (at most once), so that a caller can compute them on demand.
 template <std::invocable Normals>
+inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                       Normals&& normals, const PairThickness& th);
+
+template <std::invocable Normals>
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                 Normals&& normals) {
+                                 Normals&& normals, const PairThickness& th = {}) {
+  if (th.reach > 0.0) return dcr_detect_thick(kind, X_old, X_new, normals, th);
   DcrPenetration out;
   // Exact exits before the normals, in this order of cost. A vertex and a face (s = -1):
   // s V(X_new) < -tol needs V(X_new) > 0. Two edges whose volume has the same sign at both
@@ -367,10 +423,76 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   return out;
 }
 
+/// Samples of g_h(t) over a step in dcr_detect_thick (its final sign change is bracketed on
+/// them, then bisected).
+inline constexpr int kDcrThickSamples = 16;
+
+/// dcr_detect for a thick pair (th.reach = h > 0, PairThickness): the constraint g_h(t) =
+/// pair_gap at X_old + t (X_new - X_old), which is not a polynomial in t (|n| is a square
+/// root). Orientation: a vertex and a shell's face (th.sheet_face), s = the side the vertex
+/// starts on (sign of V(X_old)); a vertex and a solid's face, s = -1; two edges,
+/// dcr_orientation (a shell's edge has no outward normal: two shells' edges take the side
+/// they start on). Penetration: g_h(1) < -tol, and either
+///  - g_h crosses 0 in the step: t* the start of the final negative stretch (bracketed on
+///    kDcrThickSamples samples, bisected), with the closest point inside the primitives at t*
+///    or beyond their boundary by up to h: dcr_inside_margin >= -kDcrInsideTolerance - h / L
+///    (L the longest edge). The face's plane and the edges' lines reach h past their ends, so
+///    that a vertex meeting a vertex or an edge of a convex net, which no face or crossing of
+///    edges holds, is caught by the faces around it (the thickened sheet's convex corners are
+///    thus flat facets, not spheres of radius h);
+///  - or g_h < 0 all step long with s V(X_old) >= 0: the pair starts inside the layer on its
+///    admissible side of the mid-surface (a vertex sliding over a shell's face from its
+///    neighbour, whose plane is tilted; or left by an earlier step), t* = 0, inside at X_new.
+/// A pair starting behind the plane, s V(X_old) < 0 (e.g. behind a solid's face), is none.
+/// No grazing filter: the faces of a thick pair are never coplanar with the contact.
+template <std::invocable Normals>
+inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                       Normals&& normals, const PairThickness& th) {
+  DcrPenetration out;
+  const double h = th.reach;
+  const double tol = dcr_touch_tolerance(kind, X_old, X_new);
+  // Whatever s is, g_h(1) >= |V| - h |n| / 6: no penetration when that is >= -tol.
+  if (std::abs(pair_volume(X_new)) - h * pair_normal_norm(kind, X_new) / 6.0 >= -tol) return out;
+  const double V_old = pair_volume(X_old);
+  double s = -1.0;
+  if (kind == DcrPairKind::EdgeEdge) s = dcr_orientation(kind, X_old, normals(), tol);
+  else if (th.sheet_face) s = V_old > 0.0 ? 1.0 : -1.0;
+  out.orientation = s;
+  if (s == 0.0) return out;
+  const PairPoints D = X_new - X_old;
+  auto g = [&](double t) { return pair_gap(kind, s, h, PairPoints(X_old + t * D)); };
+  if (!(g(1.0) < -tol)) return out;
+  double t_star = -1.0, after = 1.0;
+  for (int k = kDcrThickSamples - 1; k >= 0; --k) {
+    const double t = static_cast<double>(k) / kDcrThickSamples;
+    if (g(t) >= 0.0) {
+      double a = t, b = after;  // g(a) >= 0 > g(b)
+      for (int it = 0; it < 200; ++it) {
+        const double m = 0.5 * (a + b);
+        if (m == a || m == b) break;
+        (g(m) >= 0.0 ? a : b) = m;
+      }
+      t_star = a;
+      break;
+    }
+    after = t;
+  }
+  const bool inside_from_start = t_star < 0.0;
+  if (inside_from_start) {
+    if (!(s * V_old >= 0.0)) return out;
+    t_star = 0.0;
+  }
+  const PairPoints X_in = inside_from_start ? X_new : PairPoints(X_old + t_star * D);
+  if (!(dcr_inside_margin(kind, X_in) >= -kDcrInsideTolerance - h / pair_length_scale(kind, X_in))) return out;
+  out.penetrating = true;
+  out.time = t_star;
+  return out;
+}
+
 /// dcr_detect with the pair's normals at hand.
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                 const PairNormals& N) {
-  return dcr_detect(kind, X_old, X_new, [&] { return N; });
+                                 const PairNormals& N, const PairThickness& th = {}) {
+  return dcr_detect(kind, X_old, X_new, [&] { return N; }, th);
 }
 
 /// Removes the penetration of a pair in place by the mass-weighted projection
@@ -389,8 +511,13 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// `shift` (if any) accumulates the mass-weighted displacements mu grad g (kg m), the
 /// projection's "impulse" on each node (a rigid body moves by it: PairMobility).
 template <class Weights>
+bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
+                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift);
+
+template <class Weights>
 bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
-                 const Weights& inv_mass, double gap, PairPoints* shift = nullptr) {
+                 const Weights& inv_mass, double gap, PairPoints* shift = nullptr, double reach = 0.0) {
+  if (reach > 0.0) return dcr_project_thick(kind, orientation, reach, X_contact, X, inv_mass, gap, shift);
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
@@ -416,6 +543,41 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
     if (g(mu) >= 0.0) break;
   }
   return s * pair_volume(X) > 0.0;
+}
+
+/// dcr_project for a thick pair (reach = h > 0): the same mass-weighted move
+/// x_i += mu W_i grad_i g_h (at X_contact in the first pass, at X after), mu the smallest
+/// root of g_h(mu) = target found by doubling from the linear estimate -g_h(0) / (G . W G)
+/// (up to 16 times it) and bisection, since g_h(mu) is no cubic.
+template <class Weights>
+bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
+                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift) {
+  const double s = orientation, h = reach;
+  const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
+  for (int pass = 0; pass < 4; ++pass) {
+    const PairPoints G = pair_gap_gradient(kind, s, h, pass == 0 ? X_contact : X);
+    const PairPoints D = weighted(G, inv_mass);
+    auto g = [&](double mu) { return pair_gap(kind, s, h, PairPoints(X + mu * D)) - target; };
+    const double g0 = g(0.0), slope = (G.array() * D.array()).sum();
+    if (g0 >= 0.0) return true;
+    if (!(slope > 0.0)) continue;  // all nodes fixed, or no separating direction
+    double lo = 0.0, hi = -g0 / slope, mu = 0.0;
+    for (int k = 0; k < 5 && g(hi) < 0.0; ++k) lo = hi, hi *= 2.0;
+    if (g(hi) >= 0.0) {
+      for (int it = 0; it < 200; ++it) {
+        const double m = 0.5 * (lo + hi);
+        if (m == lo || m == hi) break;
+        (g(m) >= 0.0 ? hi : lo) = m;
+      }
+      mu = hi;
+    } else {
+      mu = hi;  // the most reached; the gradient is re-evaluated at X
+    }
+    X += mu * D;
+    if (shift) *shift += mu * G;
+    if (g(0.0) >= 0.0) break;
+  }
+  return pair_gap(kind, s, h, X) > 0.0;
 }
 
 /// The node's mass for the angular-momentum counterpart of a projection (1/kg -> kg), or 0
@@ -494,7 +656,7 @@ struct DcrImpulse {
 
 /// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
 /// "Solving the collision equations"), V (columns, m/s) updated in place.
-/// Normal: with G = grad g(X), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
+/// Normal: with G = grad g(X) (g_h of pair_gap_gradient for a thick pair, reach = h), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
 ///   v_n = G . V / (G . W G)  [kg m/s];  if v_n < 0 (approaching):
 ///   V' = V - (1 + e) v_n W G,  dissipated = (1 - e^2) v_n^2 (G . W G) / 2.
 /// Friction: the contact point splits as sum_i c_i x_i (vertex minus the barycentric point
@@ -509,9 +671,9 @@ struct DcrImpulse {
 /// else slide with the limit: V' = V - j W F, dissipated j (F . W F) (v_s - j / 2).
 template <class Weights>
 DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X, PairPoints& V,
-                       const Weights& inv_mass, const DcrLaw& law) {
+                       const Weights& inv_mass, const DcrLaw& law, double reach = 0.0) {
   DcrImpulse out;
-  const PairPoints G = orientation * pair_volume_gradient(X);
+  const PairPoints G = pair_gap_gradient(kind, orientation, reach, X);
   const PairPoints D = weighted(G, inv_mass);
   const double q = (G.array() * D.array()).sum();
   if (!(q > 0.0)) return out;
@@ -615,23 +777,24 @@ struct DcrPairResponse {
 /// step with the same tau act at the same configuration. The final projection (at fixed
 /// velocities) is the exception that moves angular momentum and energy: it is needed when the
 /// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
-/// strongly curved g(t)). X_new and V are updated in place.
+/// strongly curved g(t)). X_new and V are updated in place. th: the pair's thickness
+/// (PairThickness; a pair of solids by default), g = g_h throughout.
 template <class Weights>
 DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new, PairPoints& V,
                                  const PairNormals& N, const Weights& inv_mass, const DcrLaw& law,
-                                 double half_dt) {
+                                 double half_dt, const PairThickness& th = {}) {
   DcrPairResponse out;
-  const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N);
+  const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N, th);
   if (!pen.penetrating) return out;
   out.active = true;
-  const double s = pen.orientation;
+  const double s = pen.orientation, h = th.reach;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
   if (law.placement == DcrPlacement::End) {
     const PairPoints X_before = X_new;
-    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift);
+    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift, h);
     PairPoints spin = PairPoints::Zero();
     out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &spin);
-    out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
+    out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law, h);
     out.impulse.applied += spin;
     return out;
   }
@@ -639,7 +802,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
       law.placement == DcrPlacement::Middle ? half_dt : 2.0 * half_dt * (1.0 - pen.time);
   const PairPoints X_c = X_new - tau * V;
   const PairPoints V_before = V;
-  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law);
+  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law, h);
   X_new += tau * (V - V_before);
   out.shift = tau * out.impulse.applied;
   // What is left is projected, to no less than twice the touching tolerance and, in the
@@ -651,14 +814,14 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   const double touch = 2.0 * dcr_touch_tolerance(kind, X_old, X_new);
   const double target =
       law.placement == DcrPlacement::Middle
-          ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
+          ? std::max(touch, std::min(law.gap * unit, 0.5 * pair_gap(kind, s, h, X_old)))
           : touch;
-  if (s * pair_volume(X_new) >= target) {
+  if (pair_gap(kind, s, h, X_new) >= target) {
     out.separated = true;
     return out;
   }
   const PairPoints X_before = X_new;
-  out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift);
+  out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift, h);
   out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &out.impulse.applied);
   return out;
 }
