@@ -161,7 +161,7 @@ PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface)
   if (surface.reach.empty()) return {};
   const auto& n = pair.nodes;
   const int b = pair.kind == ContactPair::VertexFace ? 1 : 2;
-  return {surface.reach[n[0]] + surface.reach[n[b]], b == 1 && surface.reach[n[1]] > 0.0};
+  return {surface.reach[n[0]] + surface.reach[n[b]]};
 }
 
 PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, const TriangleNormals& tn) {
@@ -169,9 +169,8 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
   if (!surface.surface) return N;
   const auto& n = pair.nodes;
   const bool vf = pair.kind == ContactPair::VertexFace;
-  auto sheet = [&](Index node) { return !surface.reach.empty() && surface.reach[node] > 0.0; };
-  if (!sheet(n[0])) N.col(0) = surface_normal(*surface.surface, *surface.around, tn, n[0], vf ? -1 : n[1]);
-  if (!vf && !sheet(n[2])) N.col(1) = surface_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
+  N.col(0) = surface_normal(*surface.surface, *surface.around, tn, n[0], vf ? -1 : n[1]);
+  if (!vf) N.col(1) = surface_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
   return N;
 }
 

@@ -155,53 +155,96 @@ inline double pair_normal_norm(DcrPairKind kind, const PairPoints& X) {
 
 /// The thickness of a pair with a shell among its sides (docs/shells.md "Contact"). A shell's
 /// contact surface is its control mesh, the mid-surface's control net, thickened by its
-/// half-thickness r on both sides; a pair of sides with r_1 and r_2 (0 for a solid) keeps its
-/// points apart by h = r_1 + r_2 along the primitives' common normal n:
-///   g_h(X) = s V(X) - h |n(X)| / 6 = |n| (s d - h) / 6,
-/// d = 6 V / |n| the signed distance of the vertex from the face's plane / of the two edges'
-/// lines. g_h is invariant under translations and rotations of the four points, as V is, so
-/// its impulses keep both momenta exactly. With h = 0 every function below is the solids'.
+/// half-thickness r: the points within r of it (both faces at +-r, rounded at the edges and
+/// vertices). A pair of sides with r_1 and r_2 (0 for a solid) keeps its primitives h = r_1 + r_2
+/// apart: its constraint is
+///   g_h(X) = dist(X) - h  (m),
+/// dist the distance between the vertex and the triangle (closest point on the triangle, its
+/// interior, an edge or a corner) / between the two segments (closest points, clamped to the
+/// segments). dist is invariant under translations and rotations of the four points, so its
+/// gradient has zero net force and torque and the impulses along it keep both momenta
+/// exactly, as the volume's do; no side is needed (a sheet has two outer faces).
 struct PairThickness {
-  double reach = 0.0;       ///< h = r_1 + r_2, m
-  bool sheet_face = false;  ///< vertex-face: the face is a shell's, two-sided (s from the side the vertex starts on)
+  double reach = 0.0;  ///< h = r_1 + r_2, m; 0: a pair of solids (the volume constraint)
 };
 
-/// grad |n| (m): vertex-face n = e1 x e2 (e1 = b - a, e2 = c - a): d|n|/db = e2 x n^,
-/// d|n|/dc = n^ x e1, d|n|/da = -(both), d|n|/dp = 0; edge-edge n = ea x eb: d|n|/da1 = eb x n^
-/// = -d|n|/da0, d|n|/db1 = n^ x ea = -d|n|/db0. Zero when n = 0.
-inline PairPoints pair_normal_norm_gradient(DcrPairKind kind, const PairPoints& X) {
-  PairPoints G = PairPoints::Zero();
+/// The distance of a pair's primitives (m) and its gradient (columns, dimensionless): with
+/// the closest points q_A = sum_i c_i x_i on the vertex / edge a and q_B = sum_j c_j x_j on the
+/// face / edge b (c the barycentric or segment weights of the closest points, clamped to the
+/// primitives) and u = (q_A - q_B) / |q_A - q_B|, d dist / d x_i = c_i u on side A and -c_j u
+/// on side B (the closest point moves with the primitive; its motion along it is second
+/// order). Zero gradient where the primitives meet (dist = 0).
+struct PairDistance {
+  double distance = 0.0;
+  PairPoints gradient = PairPoints::Zero();
+};
+
+inline PairDistance pair_distance(DcrPairKind kind, const PairPoints& X) {
+  PairWeights c = PairWeights::Zero();  // weights of the closest points: side A positive, side B negative
   if (kind == DcrPairKind::VertexFace) {
-    const Vec3 e1 = X.col(2) - X.col(1), e2 = X.col(3) - X.col(1), n = e1.cross(e2);
-    const double l = n.norm();
-    if (!(l > 0.0)) return G;
-    const Vec3 u = n / l;
-    G.col(2) = e2.cross(u);
-    G.col(3) = u.cross(e1);
-    G.col(1) = -(G.col(2) + G.col(3));
-    return G;
+    // The closest point of the triangle to p: the face's interior if the projection lies in
+    // it, else the closest point of the nearest edge.
+    const Vec3 p = X.col(0), a = X.col(1), b = X.col(2), cc = X.col(3);
+    const Vec3 e1 = b - a, e2 = cc - a, w = p - a;
+    const Vec3 n = e1.cross(e2);
+    const double nn = n.squaredNorm();
+    double lb = -1, lc = -1;
+    if (nn > 0) lb = w.cross(e2).dot(n) / nn, lc = e1.cross(w).dot(n) / nn;
+    std::array<double, 3> l{};
+    if (nn > 0 && lb >= 0 && lc >= 0 && lb + lc <= 1) {
+      l = {1 - lb - lc, lb, lc};
+    } else {
+      double best = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const int i = k, j = (k + 1) % 3;
+        const Vec3 u = X.col(1 + j) - X.col(1 + i);
+        const double uu = u.squaredNorm();
+        const double s = uu > 0 ? std::clamp((p - X.col(1 + i)).dot(u) / uu, 0.0, 1.0) : 0.0;
+        const double d2 = (p - X.col(1 + i) - s * u).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          l = {0, 0, 0};
+          l[i] = 1 - s;
+          l[j] = s;
+        }
+      }
+    }
+    c << 1.0, -l[0], -l[1], -l[2];
+  } else {
+    // Closest points of the segments a0 + sa ea, b0 + sb eb, sa, sb in [0, 1]: the lines'
+    // closest points clamped, each re-projected on the other segment.
+    const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), r = X.col(0) - X.col(2);
+    const double aa = ea.dot(ea), bb = eb.dot(eb), ab = ea.dot(eb), ar = ea.dot(r), br = eb.dot(r);
+    const double den = aa * bb - ab * ab;
+    double sa = 0, sb = 0;
+    if (aa > 0 && bb > 0) {
+      sa = den > kDcrParallelTolerance * aa * bb ? std::clamp((ab * br - bb * ar) / den, 0.0, 1.0) : 0.0;
+      sb = (ab * sa + br) / bb;
+      if (sb < 0 || sb > 1) {
+        sb = std::clamp(sb, 0.0, 1.0);
+        sa = std::clamp((ab * sb - ar) / aa, 0.0, 1.0);
+      }
+    }
+    c << 1 - sa, sa, -(1 - sb), -sb;
   }
-  const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), n = ea.cross(eb);
-  const double l = n.norm();
-  if (!(l > 0.0)) return G;
-  const Vec3 u = n / l;
-  G.col(1) = eb.cross(u);
-  G.col(0) = -G.col(1);
-  G.col(3) = u.cross(ea);
-  G.col(2) = -G.col(3);
-  return G;
+  PairDistance out;
+  const Vec3 gap = X * c;  // q_A - q_B
+  out.distance = gap.norm();
+  if (!(out.distance > 0)) return out;
+  const Vec3 u = gap / out.distance;
+  out.gradient = u * c.transpose();
+  return out;
 }
 
-/// The constraint g_h = s V - h |n| / 6 of a pair (m^3; PairThickness), s V for h = 0.
+/// The constraint of a pair: s V (m^3) for a pair of solids (h = 0), dist - h (m) for a thick
+/// one (PairThickness; s is not read).
 inline double pair_gap(DcrPairKind kind, double s, double h, const PairPoints& X) {
-  const double g = s * pair_volume(X);
-  return h > 0.0 ? g - h * pair_normal_norm(kind, X) / 6.0 : g;
+  return h > 0.0 ? pair_distance(kind, X).distance - h : s * pair_volume(X);
 }
 
-/// grad g_h (m^2), s grad V for h = 0.
+/// grad of pair_gap: s grad V (m^2), or grad dist (dimensionless) for h > 0.
 inline PairPoints pair_gap_gradient(DcrPairKind kind, double s, double h, const PairPoints& X) {
-  const PairPoints G = s * pair_volume_gradient(X);
-  return h > 0.0 ? PairPoints(G - (h / 6.0) * pair_normal_norm_gradient(kind, X)) : G;
+  return h > 0.0 ? pair_distance(kind, X).gradient : PairPoints(s * pair_volume_gradient(X));
 }
 
 /// The touching tolerance on |g| over a step (m^3): kDcrTouchTolerance L |n| / 6 with L
@@ -359,7 +402,7 @@ inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
 /// that pass the cheap tests (at most once), so that a caller can compute them on demand.
 template <std::invocable Normals>
 inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                       Normals&& normals, const PairThickness& th);
+                                       Normals&&, const PairThickness& th);
 
 template <std::invocable Normals>
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
@@ -427,63 +470,37 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// them, then bisected).
 inline constexpr int kDcrThickSamples = 16;
 
-/// dcr_detect for a thick pair (th.reach = h > 0, PairThickness): the constraint g_h(t) =
-/// pair_gap at X_old + t (X_new - X_old), which is not a polynomial in t (|n| is a square
-/// root). Orientation: a vertex and a shell's face (th.sheet_face), s = the side the vertex
-/// starts on (sign of V(X_old)); a vertex and a solid's face, s = -1; two edges,
-/// dcr_orientation (a shell's edge has no outward normal: two shells' edges take the side
-/// they start on). Penetration: g_h(1) < -tol, and either
-///  - g_h crosses 0 in the step: t* the start of the final negative stretch (bracketed on
-///    kDcrThickSamples samples, bisected), with the closest point inside the primitives at t*
-///    or beyond their boundary by up to h: dcr_inside_margin >= -kDcrInsideTolerance - h / L
-///    (L the longest edge). The face's plane and the edges' lines reach h past their ends, so
-///    that a vertex meeting a vertex or an edge of a convex net, which no face or crossing of
-///    edges holds, is caught by the faces around it (the thickened sheet's convex corners are
-///    thus flat facets, not spheres of radius h);
-///  - or g_h < 0 all step long with s V(X_old) >= 0: the pair starts inside the layer on its
-///    admissible side of the mid-surface (a vertex sliding over a shell's face from its
-///    neighbour, whose plane is tilted; or left by an earlier step), t* = 0, inside at X_new.
-/// A pair starting behind the plane, s V(X_old) < 0 (e.g. behind a solid's face), is none.
-/// No grazing filter: the faces of a thick pair are never coplanar with the contact.
+/// dcr_detect for a thick pair (th.reach = h > 0, PairThickness): g_h(t) = dist - h at
+/// X_old + t (X_new - X_old), piecewise smooth in t (no polynomial). Penetration:
+/// g_h(1) < -tol (tol = kDcrTouchTolerance L, L the longest edge), with t* the start of the
+/// final stretch of g_h < 0 (bracketed on kDcrThickSamples samples, bisected), or t* = 0 when
+/// g_h < 0 all step long (a pair starting inside the layer: a vertex sliding along the
+/// sheet into a neighbour's reach, or one left by an earlier step). No inside test: the
+/// distance is to the whole primitive (corners and edges included), and no orientation
+/// (out.orientation = 1, not read). The normals are not read.
 template <std::invocable Normals>
 inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                       Normals&& normals, const PairThickness& th) {
+                                       Normals&&, const PairThickness& th) {
   DcrPenetration out;
-  const double h = th.reach;
-  const double tol = dcr_touch_tolerance(kind, X_old, X_new);
-  // Whatever s is, g_h(1) >= |V| - h |n| / 6: no penetration when that is >= -tol.
-  if (std::abs(pair_volume(X_new)) - h * pair_normal_norm(kind, X_new) / 6.0 >= -tol) return out;
-  const double V_old = pair_volume(X_old);
-  double s = -1.0;
-  if (kind == DcrPairKind::EdgeEdge) s = dcr_orientation(kind, X_old, normals(), tol);
-  else if (th.sheet_face) s = V_old > 0.0 ? 1.0 : -1.0;
-  out.orientation = s;
-  if (s == 0.0) return out;
+  const double h = th.reach, tol = kDcrTouchTolerance * pair_length_scale(kind, X_old);
   const PairPoints D = X_new - X_old;
-  auto g = [&](double t) { return pair_gap(kind, s, h, PairPoints(X_old + t * D)); };
+  auto g = [&](double t) { return pair_distance(kind, PairPoints(X_old + t * D)).distance - h; };
   if (!(g(1.0) < -tol)) return out;
-  double t_star = -1.0, after = 1.0;
+  double t_star = 0.0, after = 1.0;
   for (int k = kDcrThickSamples - 1; k >= 0; --k) {
     const double t = static_cast<double>(k) / kDcrThickSamples;
     if (g(t) >= 0.0) {
-      double a = t, b = after;  // g(a) >= 0 > g(b)
+      double lo = t, hi = after;  // g(lo) >= 0 > g(hi)
       for (int it = 0; it < 200; ++it) {
-        const double m = 0.5 * (a + b);
-        if (m == a || m == b) break;
-        (g(m) >= 0.0 ? a : b) = m;
+        const double m = 0.5 * (lo + hi);
+        if (m == lo || m == hi) break;
+        (g(m) >= 0.0 ? lo : hi) = m;
       }
-      t_star = a;
+      t_star = lo;
       break;
     }
     after = t;
   }
-  const bool inside_from_start = t_star < 0.0;
-  if (inside_from_start) {
-    if (!(s * V_old >= 0.0)) return out;
-    t_star = 0.0;
-  }
-  const PairPoints X_in = inside_from_start ? X_new : PairPoints(X_old + t_star * D);
-  if (!(dcr_inside_margin(kind, X_in) >= -kDcrInsideTolerance - h / pair_length_scale(kind, X_in))) return out;
   out.penetrating = true;
   out.time = t_star;
   return out;
@@ -546,14 +563,14 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
 }
 
 /// dcr_project for a thick pair (reach = h > 0): the same mass-weighted move
-/// x_i += mu W_i grad_i g_h (at X_contact in the first pass, at X after), mu the smallest
-/// root of g_h(mu) = target found by doubling from the linear estimate -g_h(0) / (G . W G)
-/// (up to 16 times it) and bisection, since g_h(mu) is no cubic.
+/// x_i += mu W_i grad_i g_h (at X_contact in the first pass, at X after) to g_h = gap L (m),
+/// mu the smallest root found by doubling from the linear estimate -g_h(0) / (G . W G) (up
+/// to 32 times it) and bisection, since g_h(mu) is no cubic.
 template <class Weights>
 bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
                        PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift) {
   const double s = orientation, h = reach;
-  const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
+  const double target = gap * pair_length_scale(kind, X);  // m, as g_h
   for (int pass = 0; pass < 4; ++pass) {
     const PairPoints G = pair_gap_gradient(kind, s, h, pass == 0 ? X_contact : X);
     const PairPoints D = weighted(G, inv_mass);
@@ -562,7 +579,7 @@ bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const
     if (g0 >= 0.0) return true;
     if (!(slope > 0.0)) continue;  // all nodes fixed, or no separating direction
     double lo = 0.0, hi = -g0 / slope, mu = 0.0;
-    for (int k = 0; k < 5 && g(hi) < 0.0; ++k) lo = hi, hi *= 2.0;
+    for (int k = 0; k < 5 && g(hi) < 0.0; ++k) lo = hi, hi *= 2.0;  // up to 32x
     if (g(hi) >= 0.0) {
       for (int it = 0; it < 200; ++it) {
         const double m = 0.5 * (lo + hi);
@@ -656,7 +673,7 @@ struct DcrImpulse {
 
 /// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
 /// "Solving the collision equations"), V (columns, m/s) updated in place.
-/// Normal: with G = grad g(X) (g_h of pair_gap_gradient for a thick pair, reach = h), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
+/// Normal: with G = grad g(X) (pair_gap_gradient: grad dist for a thick pair, reach = h), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
 ///   v_n = G . V / (G . W G)  [kg m/s];  if v_n < 0 (approaching):
 ///   V' = V - (1 + e) v_n W G,  dissipated = (1 - e^2) v_n^2 (G . W G) / 2.
 /// Friction: the contact point splits as sum_i c_i x_i (vertex minus the barycentric point
@@ -778,7 +795,8 @@ struct DcrPairResponse {
 /// velocities) is the exception that moves angular momentum and energy: it is needed when the
 /// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
 /// strongly curved g(t)). X_new and V are updated in place. th: the pair's thickness
-/// (PairThickness; a pair of solids by default), g = g_h throughout.
+/// (PairThickness; a pair of solids by default): a thick pair, g = g_h, is placed at the end
+/// of the step whatever law.placement says.
 template <class Weights>
 DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new, PairPoints& V,
                                  const PairNormals& N, const Weights& inv_mass, const DcrLaw& law,
@@ -789,7 +807,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   out.active = true;
   const double s = pen.orientation, h = th.reach;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
-  if (law.placement == DcrPlacement::End) {
+  if (law.placement == DcrPlacement::End || h > 0.0) {
     const PairPoints X_before = X_new;
     out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift, h);
     PairPoints spin = PairPoints::Zero();
@@ -802,7 +820,7 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
       law.placement == DcrPlacement::Middle ? half_dt : 2.0 * half_dt * (1.0 - pen.time);
   const PairPoints X_c = X_new - tau * V;
   const PairPoints V_before = V;
-  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law, h);
+  out.impulse = dcr_impulse(kind, s, X_c, V, inv_mass, law);
   X_new += tau * (V - V_before);
   out.shift = tau * out.impulse.applied;
   // What is left is projected, to no less than twice the touching tolerance and, in the
@@ -814,14 +832,14 @@ DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, Pair
   const double touch = 2.0 * dcr_touch_tolerance(kind, X_old, X_new);
   const double target =
       law.placement == DcrPlacement::Middle
-          ? std::max(touch, std::min(law.gap * unit, 0.5 * pair_gap(kind, s, h, X_old)))
+          ? std::max(touch, std::min(law.gap * unit, 0.5 * s * pair_volume(X_old)))
           : touch;
-  if (pair_gap(kind, s, h, X_new) >= target) {
+  if (s * pair_volume(X_new) >= target) {
     out.separated = true;
     return out;
   }
   const PairPoints X_before = X_new;
-  out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift, h);
+  out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, target / unit, &out.shift);
   out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &out.impulse.applied);
   return out;
 }

@@ -138,8 +138,8 @@ ContactRun run(const Model& m, Simulation& sim, int steps) {
 // Frictionless and elastic, coarse (310 control vertices a sphere), 300 steps of 1e-4
 // (0.77 of the stable step) to t = 0.03: momenta to round-off at every step, no control
 // vertex within t of the other shell's control net (less 1e-4 t: the gap DCR leaves is
-// 1e-6 of an edge), the ledger's total within 2 % (measured 0.75 %; the same scene of
-// solid TET4 spheres, scenes/regression/spheres_impact.yaml, 1.3 %).
+// 1e-6 of an edge), the ledger's total within 2e-3 (measured 2.5e-4; the same scene of
+// solid TET4 spheres, scenes/regression/spheres_impact.yaml, 1.3e-2).
 TEST(ShellContact, TwoSpheresFrictionless) {
   Model m = build_model(scene_from_text("shell_spheres", two_spheres("shell_spheres", 0.0, 0.25, 1e-4)));
   Simulation sim(m, {});
@@ -151,11 +151,12 @@ TEST(ShellContact, TwoSpheresFrictionless) {
   EXPECT_LT(r.dP, 1e-13);
   EXPECT_LT(r.dL, 1e-13);
   EXPECT_GT(r.distance, 1 - 1e-4);
-  EXPECT_LT(r.energy, 2e-2);
+  EXPECT_LT(r.energy, 2e-3);
 }
 
 // With Coulomb friction mu = 0.5: the same momenta and distance, friction takes energy
-// (contact_dissipated > 0.1 % of the total), and the ledger, with it booked, closes to 2 %.
+// (contact_dissipated > 0.1 % of the total; measured 8.8 %), and the ledger, with it
+// booked, closes to 2e-3 (measured 3.8e-4).
 TEST(ShellContact, TwoSpheresWithFrictionCloseTheLedger) {
   Model m = build_model(scene_from_text("shell_spheres_mu", two_spheres("shell_spheres_mu", 0.5, 0.25, 1e-4)));
   Simulation sim(m, {});
@@ -168,13 +169,14 @@ TEST(ShellContact, TwoSpheresWithFrictionCloseTheLedger) {
   EXPECT_LT(r.dL, 1e-13);
   EXPECT_GT(r.distance, 1 - 1e-4);
   EXPECT_GT(r.dissipated, 1e-3);
-  EXPECT_LT(r.energy, 2e-2);
+  EXPECT_LT(r.energy, 2e-3);
 }
 
 // A solid box (TET4) thrown at a shell sphere, off-centre and spinning: shell-solid
 // pairs both ways (box vertices on the sheet's faces, sheet vertices on the box's faces,
 // their edges), h = t/2. Momenta to round-off, the box's surface vertices and the
-// sheet's control vertices at least t/2 from the other's triangles, energy within 2 %.
+// sheet's control vertices at least t/2 from the other's triangles, the ledger (friction
+// mu = 0.3 booked) within 1e-2 (measured 3.3e-3).
 TEST(ShellContact, SolidBoxOnAShell) {
   std::ostringstream os;
   os << "name: shell_box\ntime: {end: 1.0, dt: 1.0e-4}\n"
@@ -195,5 +197,5 @@ TEST(ShellContact, SolidBoxOnAShell) {
   EXPECT_LT(r.dP, 1e-13);
   EXPECT_LT(r.dL, 1e-13);
   EXPECT_GT(r.distance, 1 - 1e-4);
-  EXPECT_LT(r.energy, 2e-2);
+  EXPECT_LT(r.energy, 1e-2);
 }
