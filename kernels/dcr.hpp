@@ -337,8 +337,10 @@ inline int dcr_monotone_breaks(const DcrCubic& p, double lo, double hi, std::arr
 }
 
 /// Bisection on [a, b] where p(a) and p(b) lie on different sides of 0 (p(a) < 0 <= p(b)
-/// or p(b) < 0 <= p(a)), down to adjacent doubles; returns the end on p(b)'s side.
-inline double dcr_bisect(const DcrCubic& p, double a, double b) {
+/// or p(b) < 0 <= p(a)), down to adjacent doubles; returns the end on p(b)'s side. p: a
+/// DcrCubic, or any function of one double (a thick pair's g_h).
+template <class Function>
+inline double dcr_bisect(const Function& p, double a, double b) {
   const bool a_negative = p(a) < 0.0;
   for (int it = 0; it < 200; ++it) {
     const double m = 0.5 * (a + b);
@@ -490,13 +492,7 @@ inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old
   for (int k = kDcrThickSamples - 1; k >= 0; --k) {
     const double t = static_cast<double>(k) / kDcrThickSamples;
     if (g(t) >= 0.0) {
-      double lo = t, hi = after;  // g(lo) >= 0 > g(hi)
-      for (int it = 0; it < 200; ++it) {
-        const double m = 0.5 * (lo + hi);
-        if (m == lo || m == hi) break;
-        (g(m) >= 0.0 ? lo : hi) = m;
-      }
-      t_star = lo;
+      t_star = dcr_bisect(g, after, t);  // g(t) >= 0 > g(after): the end where g >= 0
       break;
     }
     after = t;
@@ -578,18 +574,10 @@ bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const
     const double g0 = g(0.0), slope = (G.array() * D.array()).sum();
     if (g0 >= 0.0) return true;
     if (!(slope > 0.0)) continue;  // all nodes fixed, or no separating direction
-    double lo = 0.0, hi = -g0 / slope, mu = 0.0;
+    double lo = 0.0, hi = -g0 / slope;
     for (int k = 0; k < 5 && g(hi) < 0.0; ++k) lo = hi, hi *= 2.0;  // up to 32x
-    if (g(hi) >= 0.0) {
-      for (int it = 0; it < 200; ++it) {
-        const double m = 0.5 * (lo + hi);
-        if (m == lo || m == hi) break;
-        (g(m) >= 0.0 ? hi : lo) = m;
-      }
-      mu = hi;
-    } else {
-      mu = hi;  // the most reached; the gradient is re-evaluated at X
-    }
+    // The root bracketed by [lo, hi], or the most reached (the gradient is then re-evaluated at X).
+    const double mu = g(hi) >= 0.0 ? dcr_bisect(g, lo, hi) : hi;
     X += mu * D;
     if (shift) *shift += mu * G;
     if (g(0.0) >= 0.0) break;
