@@ -61,7 +61,9 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
     for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of_[n] = root(n);
   }
   ContactSurface surface = build_contact_surface(mesh, skip);
-  // The shells' control meshes, the mid-surfaces thickened by reach_ (docs/shells.md "Contact").
+  // The shells' control meshes, the mid-surfaces thickened by reach_ (docs/shells.md "Contact");
+  // nodes that fracture added (after the shells', of solids) have none.
+  if (!reach_.empty()) reach_.resize(mesh.num_nodes(), 0.0);
   std::vector<SurfaceTriangle> sheets;
   for (const ShellBody& shell : model_.shells)
     for (const auto& t : shell.mesh.triangles)
