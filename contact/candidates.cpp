@@ -98,10 +98,15 @@ std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e
   return ContactPair{ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}};
 }
 
-bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new) {
-  if (kind == ContactPair::VertexFace)
-    return boxes_overlap(swept_box<1>(X_old, X_new, 0), swept_box<3>(X_old, X_new, 1));
-  return boxes_overlap(swept_box<2>(X_old, X_new, 0), swept_box<2>(X_old, X_new, 2));
+bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new, double reach) {
+  const bool vf = kind == ContactPair::VertexFace;
+  Box a = vf ? swept_box<1>(X_old, X_new, 0) : swept_box<2>(X_old, X_new, 0);
+  const Box b = vf ? swept_box<3>(X_old, X_new, 1) : swept_box<2>(X_old, X_new, 2);
+  if (reach > 0.0) {
+    a.lo.array() -= reach;
+    a.hi.array() += reach;
+  }
+  return boxes_overlap(a, b);
 }
 
 bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {

@@ -47,8 +47,11 @@ std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e
 /// `pair` overlap: the test find_candidates applies, for one pair. Filtering a
 /// superset of candidates with it gives exactly find_candidates' list.
 bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new);
-/// The same on the pair's points already gathered (columns in ContactPair::nodes order).
-bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new);
+/// The same on the pair's points already gathered (columns in ContactPair::nodes order), the
+/// first primitive's box grown by `reach` (m) on every side: a thick pair's h (PairThickness),
+/// whose primitives touch at that distance.
+bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new,
+                        double reach = 0.0);
 
 /// Sort by ContactPair's operator< and drop duplicates (oneTBB parallel sort
 /// on a total order: the result does not depend on the thread count).

@@ -37,7 +37,8 @@ struct Outcome {
 /// nodes' new states and moved stamps when it acts.
 Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<const Vec3> x_old, std::span<Vec3> v,
                       std::span<const double> inv_mass, std::span<const std::uint8_t> held_masks, const DcrLaw& law,
-                      double dt, std::vector<long>& moved, long stamp, const DcrRigidBodies* rigid) {
+                      double dt, std::vector<long>& moved, long stamp, const DcrRigidBodies* rigid,
+                      const PairThickness& th) {
   const ContactPair& p = found.pair;
   PairPoints X_old, X_new, V, W;
   PairWeights w;
@@ -73,10 +74,10 @@ Outcome resolve_found(const FoundPair& found, std::span<Vec3> x_new, std::span<c
     mobility.w = W;
     mobility.inv_mass = rigid->bodies[body].inv_mass;
     mobility.inv_inertia = rigid->bodies[body].inv_inertia;
-    out = dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, mobility, law, 0.5 * dt);
+    out = dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, mobility, law, 0.5 * dt, th);
   } else {
-    out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, W, law, 0.5 * dt)
-               : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, w, law, 0.5 * dt);
+    out = held ? dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, W, law, 0.5 * dt, th)
+               : dcr_resolve_pair(dcr_kind(p), X_old, X_new, V, found.normals, w, law, 0.5 * dt, th);
   }
   Outcome o;
   if (!out.active) return o;
@@ -156,6 +157,13 @@ Links link_found(std::span<const FoundPair> found, std::span<const DcrKey> keys,
 
 }  // namespace
 
+PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface) {
+  if (surface.reach.empty()) return {};
+  const auto& n = pair.nodes;
+  const int b = pair.kind == ContactPair::VertexFace ? 1 : 2;
+  return {surface.reach[n[0]] + surface.reach[n[b]]};
+}
+
 PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, const TriangleNormals& tn) {
   PairNormals N = PairNormals::Zero();
   if (!surface.surface) return N;
@@ -222,12 +230,13 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
           X_old.col(c) = x_old[p.nodes[c]];
           X_new.col(c) = x_new[p.nodes[c]];
         }
-        if (first_round && !pair_boxes_overlap(p.kind, X_old, X_new)) {
+        const PairThickness th = pair_thickness(p, surface);
+        if (first_round && !pair_boxes_overlap(p.kind, X_old, X_new, th.reach)) {
           hit[k] = 3;
           continue;
         }
         const auto normals = [&] { return pair_normals(p, surface, tn); };
-        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals).penetrating ? 2 : 1;
+        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals, th).penetrating ? 2 : 1;
       }
     });
     std::vector<FoundPair> found;
@@ -293,7 +302,7 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
       tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k != r.end(); ++k)
           outcome[batch[k]] = resolve_found(found[batch[k]], x_new, x_old, v, inv_mass, held_masks, law, dt,
-                                            scratch.moved, stamp, rigid);
+                                            scratch.moved, stamp, rigid, pair_thickness(found[batch[k]].pair, surface));
       });
       for (const Index f : batch) {
         ++done;

@@ -128,7 +128,14 @@ struct DcrSurface {
   const VertexTriangles* around = nullptr;
   /// The triangles whose normals the pairs read (those around the pairs' nodes); empty: all.
   std::span<const Index> triangles = {};
+  /// Per node (empty: none), the half-thickness r of a shell's mid-surface node, m (0 for a
+  /// solid's): a pair with a shell side is thick (PairThickness, pair_thickness).
+  std::span<const double> reach = {};
 };
+
+/// The thickness of a pair (kernels/dcr.hpp PairThickness) from surface.reach: h = r of the
+/// vertex + r of the face / r of edge a + r of edge b (a primitive's nodes are of one body).
+PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface);
 
 /// The outward normals of a pair (surface_normal, from the triangle normals tn of the
 /// configuration wanted): a vertex-face pair's vertex normal (and 0), an edge-edge pair's

@@ -153,6 +153,100 @@ inline double pair_normal_norm(DcrPairKind kind, const PairPoints& X) {
   return (X.col(1) - X.col(0)).cross(X.col(3) - X.col(2)).norm();
 }
 
+/// The thickness of a pair with a shell among its sides (docs/shells.md "Contact"). A shell's
+/// contact surface is its control mesh, the mid-surface's control net, thickened by its
+/// half-thickness r: the points within r of it (both faces at +-r, rounded at the edges and
+/// vertices). A pair of sides with r_1 and r_2 (0 for a solid) keeps its primitives h = r_1 + r_2
+/// apart: its constraint is
+///   g_h(X) = dist(X) - h  (m),
+/// dist the distance between the vertex and the triangle (closest point on the triangle, its
+/// interior, an edge or a corner) / between the two segments (closest points, clamped to the
+/// segments). dist is invariant under translations and rotations of the four points, so its
+/// gradient has zero net force and torque and the impulses along it keep both momenta
+/// exactly, as the volume's do; no side is needed (a sheet has two outer faces).
+struct PairThickness {
+  double reach = 0.0;  ///< h = r_1 + r_2, m; 0: a pair of solids (the volume constraint)
+};
+
+/// The distance of a pair's primitives (m) and its gradient (columns, dimensionless): with
+/// the closest points q_A = sum_i c_i x_i on the vertex / edge a and q_B = sum_j c_j x_j on the
+/// face / edge b (c the barycentric or segment weights of the closest points, clamped to the
+/// primitives) and u = (q_A - q_B) / |q_A - q_B|, d dist / d x_i = c_i u on side A and -c_j u
+/// on side B (the closest point moves with the primitive; its motion along it is second
+/// order). Zero gradient where the primitives meet (dist = 0).
+struct PairDistance {
+  double distance = 0.0;
+  PairPoints gradient = PairPoints::Zero();
+};
+
+inline PairDistance pair_distance(DcrPairKind kind, const PairPoints& X) {
+  PairWeights c = PairWeights::Zero();  // weights of the closest points: side A positive, side B negative
+  if (kind == DcrPairKind::VertexFace) {
+    // The closest point of the triangle to p: the face's interior if the projection lies in
+    // it, else the closest point of the nearest edge.
+    const Vec3 p = X.col(0), a = X.col(1), b = X.col(2), cc = X.col(3);
+    const Vec3 e1 = b - a, e2 = cc - a, w = p - a;
+    const Vec3 n = e1.cross(e2);
+    const double nn = n.squaredNorm();
+    double lb = -1, lc = -1;
+    if (nn > 0) lb = w.cross(e2).dot(n) / nn, lc = e1.cross(w).dot(n) / nn;
+    std::array<double, 3> l{};
+    if (nn > 0 && lb >= 0 && lc >= 0 && lb + lc <= 1) {
+      l = {1 - lb - lc, lb, lc};
+    } else {
+      double best = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const int i = k, j = (k + 1) % 3;
+        const Vec3 u = X.col(1 + j) - X.col(1 + i);
+        const double uu = u.squaredNorm();
+        const double s = uu > 0 ? std::clamp((p - X.col(1 + i)).dot(u) / uu, 0.0, 1.0) : 0.0;
+        const double d2 = (p - X.col(1 + i) - s * u).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          l = {0, 0, 0};
+          l[i] = 1 - s;
+          l[j] = s;
+        }
+      }
+    }
+    c << 1.0, -l[0], -l[1], -l[2];
+  } else {
+    // Closest points of the segments a0 + sa ea, b0 + sb eb, sa, sb in [0, 1]: the lines'
+    // closest points clamped, each re-projected on the other segment.
+    const Vec3 ea = X.col(1) - X.col(0), eb = X.col(3) - X.col(2), r = X.col(0) - X.col(2);
+    const double aa = ea.dot(ea), bb = eb.dot(eb), ab = ea.dot(eb), ar = ea.dot(r), br = eb.dot(r);
+    const double den = aa * bb - ab * ab;
+    double sa = 0, sb = 0;
+    if (aa > 0 && bb > 0) {
+      sa = den > kDcrParallelTolerance * aa * bb ? std::clamp((ab * br - bb * ar) / den, 0.0, 1.0) : 0.0;
+      sb = (ab * sa + br) / bb;
+      if (sb < 0 || sb > 1) {
+        sb = std::clamp(sb, 0.0, 1.0);
+        sa = std::clamp((ab * sb - ar) / aa, 0.0, 1.0);
+      }
+    }
+    c << 1 - sa, sa, -(1 - sb), -sb;
+  }
+  PairDistance out;
+  const Vec3 gap = X * c;  // q_A - q_B
+  out.distance = gap.norm();
+  if (!(out.distance > 0)) return out;
+  const Vec3 u = gap / out.distance;
+  out.gradient = u * c.transpose();
+  return out;
+}
+
+/// The constraint of a pair: s V (m^3) for a pair of solids (h = 0), dist - h (m) for a thick
+/// one (PairThickness; s is not read).
+inline double pair_gap(DcrPairKind kind, double s, double h, const PairPoints& X) {
+  return h > 0.0 ? pair_distance(kind, X).distance - h : s * pair_volume(X);
+}
+
+/// grad of pair_gap: s grad V (m^2), or grad dist (dimensionless) for h > 0.
+inline PairPoints pair_gap_gradient(DcrPairKind kind, double s, double h, const PairPoints& X) {
+  return h > 0.0 ? pair_distance(kind, X).gradient : PairPoints(s * pair_volume_gradient(X));
+}
+
 /// The touching tolerance on |g| over a step (m^3): kDcrTouchTolerance L |n| / 6 with L
 /// from X_old and the larger |n| of X_old and X_new.
 inline double dcr_touch_tolerance(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new) {
@@ -243,8 +337,10 @@ inline int dcr_monotone_breaks(const DcrCubic& p, double lo, double hi, std::arr
 }
 
 /// Bisection on [a, b] where p(a) and p(b) lie on different sides of 0 (p(a) < 0 <= p(b)
-/// or p(b) < 0 <= p(a)), down to adjacent doubles; returns the end on p(b)'s side.
-inline double dcr_bisect(const DcrCubic& p, double a, double b) {
+/// or p(b) < 0 <= p(a)), down to adjacent doubles; returns the end on p(b)'s side. p: a
+/// DcrCubic, or any function of one double (a thick pair's g_h).
+template <class Function>
+inline double dcr_bisect(const Function& p, double a, double b) {
   const bool a_negative = p(a) < 0.0;
   for (int it = 0; it < 200; ++it) {
     const double m = 0.5 * (a + b);
@@ -307,8 +403,13 @@ inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
 /// normals: a callable returning the pair's PairNormals, called only for the few candidates
 /// that pass the cheap tests (at most once), so that a caller can compute them on demand.
 template <std::invocable Normals>
+inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                       Normals&&, const PairThickness& th);
+
+template <std::invocable Normals>
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                 Normals&& normals) {
+                                 Normals&& normals, const PairThickness& th = {}) {
+  if (th.reach > 0.0) return dcr_detect_thick(kind, X_old, X_new, normals, th);
   DcrPenetration out;
   // Exact exits before the normals, in this order of cost. A vertex and a face (s = -1):
   // s V(X_new) < -tol needs V(X_new) > 0. Two edges whose volume has the same sign at both
@@ -367,10 +468,44 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   return out;
 }
 
+/// Samples of g_h(t) over a step in dcr_detect_thick (its final sign change is bracketed on
+/// them, then bisected).
+inline constexpr int kDcrThickSamples = 16;
+
+/// dcr_detect for a thick pair (th.reach = h > 0, PairThickness): g_h(t) = dist - h at
+/// X_old + t (X_new - X_old), piecewise smooth in t (no polynomial). Penetration:
+/// g_h(1) < -tol (tol = kDcrTouchTolerance L, L the longest edge), with t* the start of the
+/// final stretch of g_h < 0 (bracketed on kDcrThickSamples samples, bisected), or t* = 0 when
+/// g_h < 0 all step long (a pair starting inside the layer: a vertex sliding along the
+/// sheet into a neighbour's reach, or one left by an earlier step). No inside test: the
+/// distance is to the whole primitive (corners and edges included), and no orientation
+/// (out.orientation = 1, not read). The normals are not read.
+template <std::invocable Normals>
+inline DcrPenetration dcr_detect_thick(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
+                                       Normals&&, const PairThickness& th) {
+  DcrPenetration out;
+  const double h = th.reach, tol = kDcrTouchTolerance * pair_length_scale(kind, X_old);
+  const PairPoints D = X_new - X_old;
+  auto g = [&](double t) { return pair_distance(kind, PairPoints(X_old + t * D)).distance - h; };
+  if (!(g(1.0) < -tol)) return out;
+  double t_star = 0.0, after = 1.0;
+  for (int k = kDcrThickSamples - 1; k >= 0; --k) {
+    const double t = static_cast<double>(k) / kDcrThickSamples;
+    if (g(t) >= 0.0) {
+      t_star = dcr_bisect(g, after, t);  // g(t) >= 0 > g(after): the end where g >= 0
+      break;
+    }
+    after = t;
+  }
+  out.penetrating = true;
+  out.time = t_star;
+  return out;
+}
+
 /// dcr_detect with the pair's normals at hand.
 inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, const PairPoints& X_new,
-                                 const PairNormals& N) {
-  return dcr_detect(kind, X_old, X_new, [&] { return N; });
+                                 const PairNormals& N, const PairThickness& th = {}) {
+  return dcr_detect(kind, X_old, X_new, [&] { return N; }, th);
 }
 
 /// Removes the penetration of a pair in place by the mass-weighted projection
@@ -389,8 +524,13 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// `shift` (if any) accumulates the mass-weighted displacements mu grad g (kg m), the
 /// projection's "impulse" on each node (a rigid body moves by it: PairMobility).
 template <class Weights>
+bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
+                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift);
+
+template <class Weights>
 bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
-                 const Weights& inv_mass, double gap, PairPoints* shift = nullptr) {
+                 const Weights& inv_mass, double gap, PairPoints* shift = nullptr, double reach = 0.0) {
+  if (reach > 0.0) return dcr_project_thick(kind, orientation, reach, X_contact, X, inv_mass, gap, shift);
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
@@ -416,6 +556,33 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
     if (g(mu) >= 0.0) break;
   }
   return s * pair_volume(X) > 0.0;
+}
+
+/// dcr_project for a thick pair (reach = h > 0): the same mass-weighted move
+/// x_i += mu W_i grad_i g_h (at X_contact in the first pass, at X after) to g_h = gap L (m),
+/// mu the smallest root found by doubling from the linear estimate -g_h(0) / (G . W G) (up
+/// to 32 times it) and bisection, since g_h(mu) is no cubic.
+template <class Weights>
+bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
+                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift) {
+  const double s = orientation, h = reach;
+  const double target = gap * pair_length_scale(kind, X);  // m, as g_h
+  for (int pass = 0; pass < 4; ++pass) {
+    const PairPoints G = pair_gap_gradient(kind, s, h, pass == 0 ? X_contact : X);
+    const PairPoints D = weighted(G, inv_mass);
+    auto g = [&](double mu) { return pair_gap(kind, s, h, PairPoints(X + mu * D)) - target; };
+    const double g0 = g(0.0), slope = (G.array() * D.array()).sum();
+    if (g0 >= 0.0) return true;
+    if (!(slope > 0.0)) continue;  // all nodes fixed, or no separating direction
+    double lo = 0.0, hi = -g0 / slope;
+    for (int k = 0; k < 5 && g(hi) < 0.0; ++k) lo = hi, hi *= 2.0;  // up to 32x
+    // The root bracketed by [lo, hi], or the most reached (the gradient is then re-evaluated at X).
+    const double mu = g(hi) >= 0.0 ? dcr_bisect(g, lo, hi) : hi;
+    X += mu * D;
+    if (shift) *shift += mu * G;
+    if (g(0.0) >= 0.0) break;
+  }
+  return pair_gap(kind, s, h, X) > 0.0;
 }
 
 /// The node's mass for the angular-momentum counterpart of a projection (1/kg -> kg), or 0
@@ -494,7 +661,7 @@ struct DcrImpulse {
 
 /// Velocity update of a pair in contact at X by momentum decompositions ([CW] sec. 3-4,
 /// "Solving the collision equations"), V (columns, m/s) updated in place.
-/// Normal: with G = grad g(X), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
+/// Normal: with G = grad g(X) (pair_gap_gradient: grad dist for a thick pair, reach = h), W = M^-1 (inv_mass, 0 = fixed node or held component: weighted),
 ///   v_n = G . V / (G . W G)  [kg m/s];  if v_n < 0 (approaching):
 ///   V' = V - (1 + e) v_n W G,  dissipated = (1 - e^2) v_n^2 (G . W G) / 2.
 /// Friction: the contact point splits as sum_i c_i x_i (vertex minus the barycentric point
@@ -509,9 +676,9 @@ struct DcrImpulse {
 /// else slide with the limit: V' = V - j W F, dissipated j (F . W F) (v_s - j / 2).
 template <class Weights>
 DcrImpulse dcr_impulse(DcrPairKind kind, double orientation, const PairPoints& X, PairPoints& V,
-                       const Weights& inv_mass, const DcrLaw& law) {
+                       const Weights& inv_mass, const DcrLaw& law, double reach = 0.0) {
   DcrImpulse out;
-  const PairPoints G = orientation * pair_volume_gradient(X);
+  const PairPoints G = pair_gap_gradient(kind, orientation, reach, X);
   const PairPoints D = weighted(G, inv_mass);
   const double q = (G.array() * D.array()).sum();
   if (!(q > 0.0)) return out;
@@ -615,23 +782,25 @@ struct DcrPairResponse {
 /// step with the same tau act at the same configuration. The final projection (at fixed
 /// velocities) is the exception that moves angular momentum and energy: it is needed when the
 /// impulse alone does not separate the pair (e < 1, pairs coupled through shared nodes,
-/// strongly curved g(t)). X_new and V are updated in place.
+/// strongly curved g(t)). X_new and V are updated in place. th: the pair's thickness
+/// (PairThickness; a pair of solids by default): a thick pair, g = g_h, is placed at the end
+/// of the step whatever law.placement says.
 template <class Weights>
 DcrPairResponse dcr_resolve_pair(DcrPairKind kind, const PairPoints& X_old, PairPoints& X_new, PairPoints& V,
                                  const PairNormals& N, const Weights& inv_mass, const DcrLaw& law,
-                                 double half_dt) {
+                                 double half_dt, const PairThickness& th = {}) {
   DcrPairResponse out;
-  const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N);
+  const DcrPenetration pen = dcr_detect(kind, X_old, X_new, N, th);
   if (!pen.penetrating) return out;
   out.active = true;
-  const double s = pen.orientation;
+  const double s = pen.orientation, h = th.reach;
   const PairPoints X_contact = X_old + pen.time * (X_new - X_old);
-  if (law.placement == DcrPlacement::End) {
+  if (law.placement == DcrPlacement::End || h > 0.0) {
     const PairPoints X_before = X_new;
-    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift);
+    out.separated = dcr_project(kind, s, X_contact, X_new, inv_mass, law.gap, &out.shift, h);
     PairPoints spin = PairPoints::Zero();
     out.work = dcr_keep_angular_momentum(X_before, X_new, V, inv_mass, &spin);
-    out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law);
+    out.impulse = dcr_impulse(kind, s, X_new, V, inv_mass, law, h);
     out.impulse.applied += spin;
     return out;
   }

@@ -31,6 +31,13 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   self_ = spec.self;
   for (const BodySpec& b : model.scene.bodies) free_rigid_.push_back(b.free_rigid);
   any_free_rigid_ = std::find(free_rigid_.begin(), free_rigid_.end(), char{1}) != free_rigid_.end();
+  // Shells (one rank): their control nodes' half-thickness; a shell never contacts itself.
+  shell_body_.assign(model.scene.bodies.size(), 0);
+  for (const ShellBody& shell : model.shells) {
+    reach_.resize(model.mesh.num_nodes(), 0.0);
+    shell_body_[shell.body] = 1;
+    for (Index v = 0; v < shell.mesh.num_vertices(); ++v) reach_[shell.first_node + v] = 0.5 * shell.thickness;
+  }
   // A part of the model brings the whole model's surface.
   if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
   else rebuild(model.mesh);
@@ -53,14 +60,23 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
     }
     for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of_[n] = root(n);
   }
-  set_surface(build_contact_surface(mesh, skip), mesh);
+  ContactSurface surface = build_contact_surface(mesh, skip);
+  // The shells' control meshes, the mid-surfaces thickened by reach_ (docs/shells.md "Contact");
+  // nodes that fracture added (after the shells', of solids) have none.
+  if (!reach_.empty()) reach_.resize(mesh.num_nodes(), 0.0);
+  std::vector<SurfaceTriangle> sheets;
+  for (const ShellBody& shell : model_.shells)
+    for (const auto& t : shell.mesh.triangles)
+      sheets.push_back({{shell.first_node + t[0], shell.first_node + t[1], shell.first_node + t[2]}, shell.body});
+  add_triangles(surface, sheets);
+  set_surface(std::move(surface), mesh);
 }
 
 bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
   if (by_body()) {
     const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
-    if (!self_ && a == b) return true;
+    if ((!self_ || shell_body_[a]) && a == b) return true;
     // Free rigid bodies touch deformable ones only (DCR moves one rigid body per pair;
     // the scene refuses two that contact.pairs lets touch): their self-pairs drop.
     if (free_rigid_[a] && free_rigid_[b]) return true;
@@ -126,13 +142,25 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
     search_patch(x_old, x_new, v);
   } else {
     const double cpu0 = thread_cpu_seconds();
-    pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_));
+    SweptBoxes boxes = inflated_boxes(surface_, x_old, x_new, margin_);
+    if (!reach_.empty()) thicken_boxes(boxes);
+    pairs_ = find_candidates(surface_, boxes);
     std::erase_if(pairs_, [&](const ContactPair& p) { return excluded(p); });
     profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
   }
   x_search_.assign(x_new.begin(), x_new.end());
   have_candidates_ = true;
   ++profile_.searches;
+}
+
+void ContactStage::thicken_boxes(SweptBoxes& boxes) const {
+  auto grow = [&](Box& b, Index node) {
+    b.lo.array() -= reach_[node];
+    b.hi.array() += reach_[node];
+  };
+  for (size_t t = 0; t < boxes.triangles.size(); ++t) grow(boxes.triangles[t], surface_.triangles[t][0]);
+  for (size_t e = 0; e < boxes.edges.size(); ++e) grow(boxes.edges[e], surface_.edges[e][0]);
+  for (size_t v = 0; v < boxes.vertices.size(); ++v) grow(boxes.vertices[v], surface_.vertices[v]);
 }
 
 void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
@@ -292,6 +320,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   if (!valid) search(x_old, x_new, v);
   lap(profile_.search_seconds);
   DcrSurface surface{&surface_, &vertex_triangles_};
+  surface.reach = reach_;
   if (dec_) surface.triangles = patch_->normal_triangles();
   const double cpu0 = thread_cpu_seconds();
   const long bytes0 = dec_ ? ranks_->bytes() : 0, posted0 = dec_ ? ranks_->posted() : 0;

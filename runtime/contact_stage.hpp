@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
 #include "contact/surface.hpp"
 #include "runtime/model.hpp"
@@ -135,7 +136,10 @@ class ContactStage {
   /// contact.self is false, or both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
   /// Whether excluded() reads the pairs' bodies (node_body_).
-  bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_; }
+  bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }
+  /// Grows each shell primitive's box by its half-thickness (reach_), so that the search finds
+  /// the pairs of thick sides within h = r_1 + r_2 (pair_boxes_overlap with reach).
+  void thicken_boxes(SweptBoxes& boxes) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
@@ -162,7 +166,9 @@ class ContactStage {
   bool self_ = true;                            ///< contact.self
   std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free
   bool any_free_rigid_ = false;
-  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false)
+  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false, or shells)
+  std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
+  std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;

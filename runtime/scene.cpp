@@ -750,9 +750,6 @@ Scene parse_scene(const std::string& text, const std::string& path, const std::v
           r.fail("contact.pairs",
                  "the free rigid bodies '" + s.bodies[a].name + "' and '" + s.bodies[b].name +
                      "' may touch; list the pairs that touch without theirs (DCR moves one rigid body per pair)");
-    for (const BodySpec& b : s.bodies)
-      if (b.shell)
-        r.fail("contact", "expected no contact block: body '" + b.name + "' is a shell (shells are not in contact yet)");
     s.contact = cs;
   }
   if (root["gravity"]) s.gravity = r.vec3(root["gravity"], "gravity");
