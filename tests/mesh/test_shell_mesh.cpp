@@ -142,8 +142,9 @@ TEST(ShellMesh, GhostVerticesKeepContinuityAndMomentumBalance) {
   const ShellMesh meshes[] = {lattice(n), square(n), square_clamped};
   for (int which = 0; which < 3; ++which) {
   const ShellMesh& m = meshes[which];
-  if (which > 0)
+  if (which > 0) {
     for (Index t = 0; t < m.num_triangles(); ++t) ASSERT_EQ(m.patch_size(t), 12) << "triangle " << t;
+  }
   std::vector<Vec3> X = m.reference;
   for (Vec3& p : X) p.z() = 0.05 * (p.x() * p.x() - p.y() * p.y());
   std::vector<Vec3> x = X;
