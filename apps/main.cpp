@@ -47,8 +47,10 @@ void print_check(const Model& model, const Simulation& sim) {
   for (Index i : d.owned_nodes()) ++count[2 * mesh.node_body[i]];
   for (Index e : d.owned_element_ids()) ++count[2 * mesh.elem_body[e] + 1];
   long shell_triangles = 0;  // a shell body's elements: its control triangles (one rank)
-  for (const ShellBody& sb : model.shells) count[2 * sb.body + 1] += sb.mesh.num_triangles();
-  for (const ShellBody& sb : model.shells) shell_triangles += sb.mesh.num_triangles();
+  for (const ShellBody& sb : model.shells) {
+    count[2 * sb.body + 1] += sb.mesh.num_triangles();
+    shell_triangles += sb.mesh.num_triangles();
+  }
   count = d.sum(count);
   MeshScaledJacobian worst;
   if (mesh.order == 2) {

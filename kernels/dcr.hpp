@@ -236,13 +236,8 @@ inline PairDistance pair_distance(DcrPairKind kind, const PairPoints& X) {
   return out;
 }
 
-/// The constraint of a pair: s V (m^3) for a pair of solids (h = 0), dist - h (m) for a thick
-/// one (PairThickness; s is not read).
-inline double pair_gap(DcrPairKind kind, double s, double h, const PairPoints& X) {
-  return h > 0.0 ? pair_distance(kind, X).distance - h : s * pair_volume(X);
-}
-
-/// grad of pair_gap: s grad V (m^2), or grad dist (dimensionless) for h > 0.
+/// The gradient of a pair's constraint: s grad V (m^2) for a pair of solids (h = 0), grad dist
+/// (dimensionless) for a thick one (PairThickness; s is not read).
 inline PairPoints pair_gap_gradient(DcrPairKind kind, double s, double h, const PairPoints& X) {
   return h > 0.0 ? pair_distance(kind, X).gradient : PairPoints(s * pair_volume_gradient(X));
 }
@@ -524,13 +519,13 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
 /// `shift` (if any) accumulates the mass-weighted displacements mu grad g (kg m), the
 /// projection's "impulse" on each node (a rigid body moves by it: PairMobility).
 template <class Weights>
-bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
-                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift);
+bool dcr_project_thick(DcrPairKind kind, double reach, const PairPoints& X_contact, PairPoints& X,
+                       const Weights& inv_mass, double gap, PairPoints* shift);
 
 template <class Weights>
 bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_contact, PairPoints& X,
                  const Weights& inv_mass, double gap, PairPoints* shift = nullptr, double reach = 0.0) {
-  if (reach > 0.0) return dcr_project_thick(kind, orientation, reach, X_contact, X, inv_mass, gap, shift);
+  if (reach > 0.0) return dcr_project_thick(kind, reach, X_contact, X, inv_mass, gap, shift);
   const double s = orientation;
   const double target = gap * pair_length_scale(kind, X) * pair_normal_norm(kind, X) / 6.0;
   for (int pass = 0; pass < 4; ++pass) {
@@ -563,14 +558,15 @@ bool dcr_project(DcrPairKind kind, double orientation, const PairPoints& X_conta
 /// mu the smallest root found by doubling from the linear estimate -g_h(0) / (G . W G) (up
 /// to 32 times it) and bisection, since g_h(mu) is no cubic.
 template <class Weights>
-bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const PairPoints& X_contact,
-                       PairPoints& X, const Weights& inv_mass, double gap, PairPoints* shift) {
-  const double s = orientation, h = reach;
+bool dcr_project_thick(DcrPairKind kind, double reach, const PairPoints& X_contact, PairPoints& X,
+                       const Weights& inv_mass, double gap, PairPoints* shift) {
+  const double h = reach;
   const double target = gap * pair_length_scale(kind, X);  // m, as g_h
+  auto g_h = [&](const PairPoints& Y) { return pair_distance(kind, Y).distance - h; };
   for (int pass = 0; pass < 4; ++pass) {
-    const PairPoints G = pair_gap_gradient(kind, s, h, pass == 0 ? X_contact : X);
+    const PairPoints G = pair_distance(kind, pass == 0 ? X_contact : X).gradient;
     const PairPoints D = weighted(G, inv_mass);
-    auto g = [&](double mu) { return pair_gap(kind, s, h, PairPoints(X + mu * D)) - target; };
+    auto g = [&](double mu) { return g_h(PairPoints(X + mu * D)) - target; };
     const double g0 = g(0.0), slope = (G.array() * D.array()).sum();
     if (g0 >= 0.0) return true;
     if (!(slope > 0.0)) continue;  // all nodes fixed, or no separating direction
@@ -582,7 +578,7 @@ bool dcr_project_thick(DcrPairKind kind, double orientation, double reach, const
     if (shift) *shift += mu * G;
     if (g(0.0) >= 0.0) break;
   }
-  return pair_gap(kind, s, h, X) > 0.0;
+  return g_h(X) > 0.0;
 }
 
 /// The node's mass for the angular-momentum counterpart of a projection (1/kg -> kg), or 0
