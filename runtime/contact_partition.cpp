@@ -2,6 +2,8 @@
 
 #include <zoltan.h>
 
+#include <algorithm>
+
 #include "kernels/error.hpp"
 
 namespace shatter {
@@ -14,7 +16,7 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   zz_ = Zoltan_Create(comm);
   SHATTER_REQUIRE(zz_, "Zoltan_Create failed");
   for (const auto& [key, value] : {std::pair{"DEBUG_LEVEL", "0"}, {"LB_METHOD", "RCB"}, {"NUM_GID_ENTRIES", "1"}, {"NUM_LID_ENTRIES", "1"},
-                                   {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "EXPORT"},
+                                   {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "IMPORT AND EXPORT"},
                                    {"RCB_REUSE", "0"}, {"KEEP_CUTS", "0"}, {"IMBALANCE_TOL", "1.02"}})
     Zoltan_Set_Param(zz_, key, value);
   Zoltan_Set_Num_Obj_Fn(
@@ -54,8 +56,8 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
 
 ContactPartition::~ContactPartition() { Zoltan_Destroy(&zz_); }
 
-std::vector<int> ContactPartition::partition(std::span<const Index> ids, std::span<const Vec3> points,
-                                             std::span<const float> weights, Index total) {
+std::vector<Index> ContactPartition::partition(std::span<const Index> ids, std::span<const Vec3> points,
+                                               std::span<const float> weights, Index total) {
   SHATTER_REQUIRE(ids.size() == points.size() && 2 * points.size() == weights.size(),
                   "ContactPartition: " << ids.size() << " ids, " << points.size() << " points, " << weights.size()
                                        << " weights");
@@ -68,26 +70,28 @@ std::vector<int> ContactPartition::partition(std::span<const Index> ids, std::sp
   const int rc = Zoltan_LB_Partition(zz_, &changes, &gid_entries, &lid_entries, &n_import, &import_gids, &import_lids,
                                      &import_procs, &import_parts, &n_export, &export_gids, &export_lids,
                                      &export_procs, &export_parts);
-  // Pairs (id, part) of the objects listed here.
-  std::vector<int> mine(2 * ids.size());
-  for (size_t k = 0; k < ids.size(); ++k) mine[2 * k] = ids[k], mine[2 * k + 1] = rank_;
-  if (rc == ZOLTAN_OK)
-    for (int k = 0; k < n_export; ++k) mine[2 * export_lids[k] + 1] = export_parts[k];
+  // The objects kept here, and those that come here (Zoltan's migration lists).
+  std::vector<Index> owned;
+  if (rc == ZOLTAN_OK) {
+    std::vector<char> leaves(ids.size(), 0);
+    for (int k = 0; k < n_export; ++k)
+      if (export_parts[k] != rank_) leaves[export_lids[k]] = 1;
+    for (size_t k = 0; k < ids.size(); ++k)
+      if (!leaves[k]) owned.push_back(ids[k]);
+    for (int k = 0; k < n_import; ++k)
+      if (import_parts[k] == rank_) owned.push_back(static_cast<Index>(import_gids[k]));
+  }
   Zoltan_LB_Free_Part(&import_gids, &import_lids, &import_procs, &import_parts);
   Zoltan_LB_Free_Part(&export_gids, &export_lids, &export_procs, &export_parts);
   // Every rank gets the same return code: Zoltan's calls are collective.
   SHATTER_REQUIRE(rc == ZOLTAN_OK, "Zoltan_LB_Partition (RCB) failed with code " << rc);
-  std::vector<int> counts(size_), displs(size_, 0);
-  const int n = static_cast<int>(mine.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  for (int r = 1; r < size_; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<int> all(displs[size_ - 1] + counts[size_ - 1]);
-  MPI_Allgatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, comm_);
-  SHATTER_REQUIRE(all.size() == 2 * static_cast<size_t>(total),
-                  "ContactPartition: " << all.size() / 2 << " objects listed for " << total);
-  std::vector<int> parts(total, -1);
-  for (size_t k = 0; k < all.size(); k += 2) parts[all[k]] = all[k + 1];
-  return parts;
+  std::sort(owned.begin(), owned.end());
+  long counts[2] = {static_cast<long>(owned.size()), static_cast<long>(ids.size())};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG, MPI_SUM, comm_);
+  SHATTER_REQUIRE(counts[0] == total && counts[1] == total,
+                  "ContactPartition: " << counts[1] << " objects listed and " << counts[0] << " owned after RCB for "
+                                       << total);
+  return owned;
 }
 
 }  // namespace shatter

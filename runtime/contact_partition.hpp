@@ -23,13 +23,13 @@ class ContactPartition {
   ContactPartition(const ContactPartition&) = delete;
   ContactPartition& operator=(const ContactPartition&) = delete;
 
-  /// The part (rank) of each of `total` objects, the same array on every rank
-  /// (collective). Each rank passes the objects it holds (ids in [0, total), each id
-  /// on exactly one rank) with their points and two weights each (>= 0, object-major),
-  /// balanced together (Zoltan's multi-criteria RCB); the parts come back through one
-  /// MPI_Allgatherv.
-  std::vector<int> partition(std::span<const Index> ids, std::span<const Vec3> points,
-                             std::span<const float> weights, Index total);
+  /// The objects this rank owns after a new partition, ascending (collective). Each rank
+  /// passes the objects it holds now (ids in [0, total), each id on exactly one rank) with
+  /// their points and two weights each (>= 0, object-major), balanced together (Zoltan's
+  /// multi-criteria RCB); it keeps those Zoltan does not export and gains those Zoltan
+  /// imports (its migration lists: no list of every object's part goes to every rank).
+  std::vector<Index> partition(std::span<const Index> ids, std::span<const Vec3> points,
+                               std::span<const float> weights, Index total);
 
  private:
   MPI_Comm comm_;

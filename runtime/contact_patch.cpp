@@ -57,17 +57,17 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
 
 ContactPatch::~ContactPatch() = default;
 
-void ContactPatch::own(std::vector<int> primitive_rank) {
+void ContactPatch::own(std::span<const Index> primitives) {
   const auto nt = static_cast<Index>(surface_.triangles.size());
-  SHATTER_REQUIRE(primitive_rank.size() == surface_.triangles.size() + surface_.edges.size(),
-                  "ContactPatch: " << primitive_rank.size() << " ranks for " << nt << " triangles and "
-                                   << surface_.edges.size() << " edges");
-  primitive_rank_ = std::move(primitive_rank);
+  const auto total = nt + static_cast<Index>(surface_.edges.size());
+  owned_once_ = true;
   owned_triangles_.clear();
   owned_edges_.clear();
   owned_ = {};
-  for (Index q = 0; q < static_cast<Index>(primitive_rank_.size()); ++q) {
-    if (primitive_rank_[q] != dec_.rank()) continue;
+  for (size_t k = 0; k < primitives.size(); ++k) {
+    const Index q = primitives[k];
+    SHATTER_REQUIRE(q >= 0 && q < total && (k == 0 || primitives[k - 1] < q),
+                    "ContactPatch: primitive " << q << " of " << total << " out of range or out of order");
     if (q < nt) {
       owned_triangles_.push_back(q);
       owned_.triangles.push_back(surface_.triangles[q]);
@@ -82,6 +82,12 @@ void ContactPatch::own(std::vector<int> primitive_rank) {
   sort_unique(owned_.vertices);
   for (auto& p : plans_) p.reset();
   plans_[static_cast<int>(PatchPlan::Owned)] = plan(owned_.vertices, false);
+}
+
+bool ContactPatch::owns(Index q) const {
+  const auto nt = static_cast<Index>(surface_.triangles.size());
+  return q < nt ? std::binary_search(owned_triangles_.begin(), owned_triangles_.end(), q)
+                : std::binary_search(owned_edges_.begin(), owned_edges_.end(), q - nt);
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {

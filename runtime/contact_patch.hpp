@@ -47,11 +47,13 @@ class ContactPatch {
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
 
-  /// A new ownership: the rank of each triangle, then of each edge (the same array on every
-  /// rank). Plans the states of the owned primitives' nodes (PatchPlan::Owned; collective).
-  void own(std::vector<int> primitive_rank);
-  bool owned_any() const { return !primitive_rank_.empty(); }
-  const std::vector<int>& primitive_rank() const { return primitive_rank_; }
+  /// A new ownership: the primitives this rank owns, ascending (triangle t as t, edge e as
+  /// the number of triangles + e); no rank learns the others'. Plans the states of the owned
+  /// primitives' nodes (PatchPlan::Owned; collective).
+  void own(std::span<const Index> primitives);
+  bool owned_any() const { return owned_once_; }
+  /// Whether this rank owns primitive q (numbered as in own()).
+  bool owns(Index q) const;
   /// The triangles and edges owned here (surface indices, ascending) and their nodes.
   std::span<const Index> owned_triangles() const { return owned_triangles_; }
   std::span<const Index> owned_edges() const { return owned_edges_; }
@@ -103,7 +105,7 @@ class ContactPatch {
   const VertexTriangles& around_;
   Index num_nodes_;
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
-  std::vector<int> primitive_rank_;
+  bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;
   ContactSurface owned_, patch_;
   std::vector<Index> normal_triangles_;

@@ -184,10 +184,11 @@ void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::s
 void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
   const auto nt = static_cast<Index>(surface_.triangles.size());
   if (!patch_->owned_any()) {
-    std::vector<int> first_owner(surface_.triangles.size() + surface_.edges.size());
-    for (size_t q = 0; q < first_owner.size(); ++q)
-      first_owner[q] = dec_->node_owner(static_cast<Index>(q) < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]);
-    patch_->own(std::move(first_owner));
+    std::vector<Index> first_owned;
+    for (Index q = 0; q < nt + static_cast<Index>(surface_.edges.size()); ++q)
+      if (dec_->node_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
+        first_owned.push_back(q);
+    patch_->own(first_owned);
   }
   // The owned primitives' states start the search (their boxes, the reach).
   exchange(x_old, x_new, v, PatchPlan::Owned);
@@ -205,7 +206,6 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
-    const std::vector<int>& rank = patch_->primitive_rank();
     for (const ContactPair& p : found) {
       Index q;
       if (p.kind == ContactPair::VertexFace) {
@@ -220,7 +220,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
         SHATTER_ASSERT(it != surface_.edges.end() && *it == edge);
         q = nt + static_cast<Index>(it - surface_.edges.begin());
       }
-      if (rank[q] != dec_->rank() || excluded(p)) continue;
+      if (!patch_->owns(q) || excluded(p)) continue;
       pairs_.push_back(p);
       weight_[q] += 1.0f;
     }
@@ -234,7 +234,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
-std::vector<int> ContactStage::partition(std::span<const Vec3> x) {
+std::vector<Index> ContactStage::partition(std::span<const Vec3> x) {
   const auto nt = static_cast<Index>(surface_.triangles.size());
   std::vector<Index> ids;
   std::vector<Vec3> points;

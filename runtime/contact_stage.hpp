@@ -147,8 +147,9 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine`; its nodes' x
   /// from the rank that found it are written into x (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine, std::span<Vec3> x) const;
-  /// The RCB partition of the owned primitives at x, weighted by their candidates.
-  std::vector<int> partition(std::span<const Vec3> x);
+  /// The primitives owned here after an RCB partition of the owned ones at x, weighted by
+  /// their candidates.
+  std::vector<Index> partition(std::span<const Vec3> x);
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
   void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
