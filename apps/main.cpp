@@ -2,6 +2,8 @@
 //   shatter run SCENE.yaml [--out DIR] [--threads T] [--set key.path=value ...]
 //             [--deterministic] [--restart CHECKPOINT.h5] [--quiet] [--max-elements N]
 //   shatter check SCENE.yaml [--set ...] [--max-elements N]
+//   shatter partition SCENE.yaml --ranks R [--out DIR] [--set ...] [--max-elements N]
+//             (the parts for R ranks, one file each, for `run --parts DIR`)
 //   shatter plot OUTDIR        (PNGs of a run's history into OUTDIR/plots/)
 // Exit status: 0 success, 2 bad input, 1 failure during the run.
 #include <mpi.h>
@@ -12,6 +14,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -25,6 +28,7 @@
 #include "runtime/disk_reserve.hpp"
 #include "runtime/model.hpp"
 #include "runtime/output_folder.hpp"
+#include "runtime/part_files.hpp"
 #include "runtime/report.hpp"
 #include "runtime/restart_check.hpp"
 #include "runtime/scene.hpp"
@@ -88,6 +92,25 @@ void print_check(const Model& model, const Simulation& sim) {
   std::printf("memory: about %.1f MB%s\n", memory / 1e6, d.distributed() ? " on the largest rank" : "");
 }
 
+/// `shatter partition`: the whole model, built here, cut into `ranks` part files
+/// in `out_dir` (default parts/<name>); prints what it wrote. On one process.
+int write_parts(const Scene& scene, int ranks, const std::string& out_dir, double max_elements, int processes) {
+  if (processes > 1)
+    throw InputError("shatter partition runs on one process (it was started on " + std::to_string(processes) +
+                     "); expected `shatter partition SCENE --ranks R` without mpirun");
+  const std::filesystem::path dir = out_dir.empty() ? std::filesystem::path("parts") / scene.name : std::filesystem::path(out_dir);
+  const Model whole = build_model(scene, MPI_COMM_SELF, max_elements);
+  const std::vector<std::uintmax_t> sizes = write_part_files(whole, ranks, dir);
+  std::uintmax_t total = 0;
+  for (const std::uintmax_t b : sizes) total += b;
+  std::printf("wrote the parts of scene %s (%d nodes, %d elements; meshed in %.1f s) for %d ranks to %s: %.1f MB, "
+              "the largest part %.1f MB\nrun them with: mpirun -np %d shatter run %s --parts %s\n",
+              scene.name.c_str(), whole.whole_nodes(), whole.whole_elements(), whole.mesh_seconds, ranks,
+              dir.c_str(), total / 1e6, *std::max_element(sizes.begin(), sizes.end()) / 1e6, ranks,
+              scene.file.c_str(), dir.c_str());
+  return 0;
+}
+
 /// Run scripts/plot.py of the source tree (SHATTER_SOURCE_DIR) with the Python
 /// that has matplotlib (SHATTER_PYTHON) on a run's output folder; returns the
 /// script's exit status (2: no such folder or no history.csv).
@@ -117,7 +140,8 @@ int cli(int argc, char** argv, FailureChannel& failures) {
 
   CLI::App app{"shatter: explicit dynamics of solids that collide, crack and fragment"};
   app.require_subcommand(1);
-  std::string scene_path, out_dir, restart;
+  std::string scene_path, out_dir, restart, parts_dir;
+  int part_ranks = 0;
   std::vector<std::string> overrides;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool deterministic = false, quiet = false;
@@ -134,10 +158,19 @@ int cli(int argc, char** argv, FailureChannel& failures) {
   run->add_option("--max-elements", max_elements, "refuse scenes whose shapes Gmsh would mesh into more elements "
                                                   "(estimated before meshing; default 5e7)")
       ->check(CLI::Range(1.0, 1e15));
+  run->add_option("--parts", parts_dir, "read each rank's part from this folder of `shatter partition`'s files "
+                                        "instead of meshing (no rank holds the whole model)");
   auto* check = app.add_subcommand("check", "check a scene and print the model summary; run nothing");
   check->add_option("scene", scene_path, "scene file (YAML)")->required();
   check->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
   check->add_option("--max-elements", max_elements, "as for run")->check(CLI::Range(1.0, 1e15));
+  auto* partition = app.add_subcommand("partition", "mesh a scene once and write its parts for R ranks, one file "
+                                                    "per rank, for `shatter run --parts DIR` (one process)");
+  partition->add_option("scene", scene_path, "scene file (YAML)")->required();
+  partition->add_option("--ranks", part_ranks, "the ranks the run will use")->required()->check(CLI::Range(2, 1 << 20));
+  partition->add_option("--out", out_dir, "folder of the part files (default parts/<name>)");
+  partition->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+  partition->add_option("--max-elements", max_elements, "as for run")->check(CLI::Range(1.0, 1e15));
   auto* plot = app.add_subcommand("plot", "plot a run's history.csv into OUTDIR/plots/ (PNG)");
   plot->add_option("outdir", out_dir, "output folder of a run")->required();
 
@@ -169,7 +202,8 @@ int cli(int argc, char** argv, FailureChannel& failures) {
     if (!restart.empty() && out_dir.empty()) opt.out_dir = std::filesystem::absolute(restart).parent_path();
     // Before the meshing: a folder that cannot take the outputs is bad input.
     if (*run) prepare_output_folder(opt.out_dir, MPI_COMM_WORLD);
-    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF, max_elements);
+    if (*partition) return write_parts(scene, part_ranks, out_dir, max_elements, ranks);
+    model = build_model(scene, ranks > 1 ? MPI_COMM_WORLD : MPI_COMM_SELF, max_elements, parts_dir);
     sim = std::make_unique<Simulation>(*model, opt);
     if (!restart.empty()) {
       CheckpointRun written;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/fnv1a.hpp"
 #include "runtime/hdf5_failure.hpp"
 #include "runtime/scene_keys.hpp"
 
@@ -47,15 +48,6 @@ RigidBodyState rigid_from_rows(const Vec3* r) {
   return b;
 }
 constexpr long kOldestVersion = 2;  // read without the physics check
-
-std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ULL) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 /// A hash of every attribute of a checkpoint (names and values; a dataset's
 /// own hash of its bytes is one of them), summed so that the order of

@@ -14,6 +14,7 @@
 #include "runtime/decomposition.hpp"
 #include "runtime/mesh_broadcast.hpp"
 #include "runtime/model_part.hpp"
+#include "runtime/part_files.hpp"
 
 namespace shatter {
 
@@ -166,7 +167,7 @@ void complete_model(Model& m, const RegionSelection& selection);
 
 }  // namespace
 
-Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
+Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const std::filesystem::path& parts) {
   Model m;
   m.scene = scene;
   for (const auto& ms : scene.materials)
@@ -181,7 +182,17 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements) {
       if (b.shell)
         throw InputError(scene.file + ": " + b.key + ".shell: shells run on one MPI rank (" + std::to_string(ranks) +
                          " here; their parts and 2-ring ghost layer are not built yet); expected mpirun -np 1");
-  if (ranks == 1) {
+  if (!parts.empty()) {
+    if (ranks == 1)
+      throw InputError("--parts " + parts.string() + ": part files are for runs on several ranks; expected mpirun -np R "
+                       "with the R of `shatter partition --ranks R`, or a run without --parts");
+    if (scene.fracture_enabled() && scene.contact)
+      throw InputError(scene.file + ": fracture with contact holds the whole model on every rank (docs/parallel.md "
+                                    "\"Limits\"); expected a run without --parts");
+    const auto t0 = std::chrono::steady_clock::now();
+    read_part_file(m, parts, comm);
+    mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  } else if (ranks == 1) {
     m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds);
     m.shells = add_shell_bodies(scene, m.mesh);
     selection = select_regions(scene, m.mesh, groups);

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <tuple>
 #include <vector>
 
@@ -142,7 +143,10 @@ void append_node_row(To& to, const From& from, Index n) {
 /// Before meshing, a primitive beyond kMaxCoordinate, or primitives whose
 /// estimated elements (estimated_elements) add up to more than
 /// `max_elements`, throw InputError naming the body's key.
-Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF, double max_elements = kDefaultMaxElements);
+/// With `parts` (a folder of `shatter partition`'s files, part_files.hpp) each rank
+/// reads its own part instead, and nothing is meshed.
+Model build_model(const Scene& scene, MPI_Comm comm = MPI_COMM_SELF, double max_elements = kDefaultMaxElements,
+                  const std::filesystem::path& parts = {});
 
 /// Recompute the lumped masses of `nodes` from element_node_mass (after node splitting).
 void recompute_node_masses(Model& model, const std::vector<Index>& nodes);

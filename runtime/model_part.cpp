@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 
 #include "kernels/error.hpp"
 #include "mesh/topology.hpp"
@@ -158,37 +159,57 @@ void receive_bytes(void* data, std::uint64_t bytes, MPI_Comm comm) {
              comm, MPI_STATUS_IGNORE);
 }
 
-void send_part(const Model& m, int dest, MPI_Comm comm) {
+}  // namespace
+
+void cut_parts(const Model& whole, int ranks, const std::function<void(int, Model&&)>& each) {
+  const Partition p = partition(whole, ranks);
+  std::vector<std::vector<Index>> held = held_elements(whole.mesh, p.touch, ranks, whole.scene.fracture_enabled());
+  std::vector<Index> local(whole.mesh.num_nodes(), -1);
+  for (int r = 0; r < ranks; ++r) {
+    Model part = cut(whole, p, std::move(held[r]), local);
+    // (cut() grows its arrays one push at a time; a received or read part's are exact.)
+    for_each_array(part, [](auto& v) { v.shrink_to_fit(); });
+    each(r, std::move(part));
+  }
+}
+
+void put_part(const Model& m, const std::function<void(const void*, std::uint64_t)>& put) {
   const std::uint64_t head[6] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
                                  static_cast<std::uint64_t>(m.part.whole_elements),
                                  static_cast<std::uint64_t>(m.part.whole_nodes),
                                  static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint};
-  send_bytes(head, sizeof head, dest, comm);
+  put(head, sizeof head);
   for_each_array(m, [&](const auto& v) {
     const std::uint64_t n = v.size();
-    send_bytes(&n, sizeof n, dest, comm);
-    send_bytes(v.data(), n * sizeof(v[0]), dest, comm);
+    put(&n, sizeof n);
+    put(v.data(), n * sizeof(v[0]));
   });
 }
 
-void receive_part(Model& m, MPI_Comm comm) {
+bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std::uint64_t)>& get) {
   std::uint64_t head[6];
-  receive_bytes(head, sizeof head, comm);
+  if (limit < sizeof head) return false;
+  get(head, sizeof head);
+  limit -= sizeof head;
   m.mesh.order = static_cast<int>(head[0]);
   m.mesh.revision = head[1];
   m.part.whole_elements = static_cast<Index>(head[2]);
   m.part.whole_nodes = static_cast<Index>(head[3]);
   m.part.whole_bc_nodes = static_cast<Index>(head[4]);
   m.part.fingerprint = head[5];
+  bool fits = true;
   for_each_array(m, [&](auto& v) {
     std::uint64_t n = 0;
-    receive_bytes(&n, sizeof n, comm);
+    if (!fits || limit < sizeof n) return void(fits = false);
+    get(&n, sizeof n);
+    limit -= sizeof n;
+    if (n > limit / sizeof(v[0])) return void(fits = false);
     v.resize(n);
-    receive_bytes(v.data(), n * sizeof(v[0]), comm);
+    get(v.data(), n * sizeof(v[0]));
+    limit -= n * sizeof(v[0]);
   });
+  return fits;
 }
-
-}  // namespace
 
 Index number_split_nodes(Model& m, Index first, std::uint64_t revision, const Decomposition& dec) {
   Mesh& mesh = m.mesh;
@@ -229,14 +250,15 @@ void distribute_parts(Model& model, MPI_Comm comm) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
-  if (rank != 0) return receive_part(model, comm);
-  const Partition p = partition(model, ranks);
-  std::vector<std::vector<Index>> held = held_elements(model.mesh, p.touch, ranks, model.scene.fracture_enabled());
-  std::vector<Index> local(model.mesh.num_nodes(), -1);
-  for (int r = 1; r < ranks; ++r) send_part(cut(model, p, std::move(held[r]), local), r, comm);
-  Model mine = cut(model, p, std::move(held[0]), local);
-  // (cut() grows its arrays one push at a time; the received ones are exact.)
-  for_each_array(mine, [](auto& v) { v.shrink_to_fit(); });
+  if (rank != 0) {
+    get_part(model, ~std::uint64_t{0}, [&](void* data, std::uint64_t bytes) { receive_bytes(data, bytes, comm); });
+    return;
+  }
+  Model mine;
+  cut_parts(model, ranks, [&](int r, Model&& part) {
+    if (r == 0) return void(mine = std::move(part));
+    put_part(part, [&](const void* data, std::uint64_t bytes) { send_bytes(data, bytes, r, comm); });
+  });
   mine.scene = std::move(model.scene);
   mine.materials = std::move(model.materials);
   model = std::move(mine);

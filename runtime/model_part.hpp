@@ -10,6 +10,9 @@
 // (docs/parallel.md "Fracture on parts").
 #include <mpi.h>
 
+#include <cstdint>
+#include <functional>
+
 #include "runtime/model.hpp"
 
 namespace shatter {
@@ -20,6 +23,18 @@ class Decomposition;
 /// they receive into `model` (holding the scene and materials); rank 0's
 /// `model` becomes its own part and the whole model is freed. Collective.
 void distribute_parts(Model& model, MPI_Comm comm);
+
+/// Cuts `whole` into its parts for `ranks` ranks (the partition distribute_parts
+/// uses) and hands each, in rank order, to each(rank, part) (without scene and
+/// materials). Holds the whole model and one part at a time.
+void cut_parts(const Model& whole, int ranks, const std::function<void(int, Model&&)>& each);
+
+/// A part's arrays as bytes, in a fixed order, through put(data, bytes).
+void put_part(const Model& part, const std::function<void(const void*, std::uint64_t)>& put);
+/// The inverse of put_part through get(data, bytes); `limit`: the bytes that can
+/// be read. Returns false (the part incomplete) when a length read would go
+/// past the limit, so a damaged length never allocates more than is there.
+bool get_part(Model& part, std::uint64_t limit, const std::function<void(void*, std::uint64_t)>& get);
 
 /// After a split on parts (docs/parallel.md "Fracture on parts"): the whole
 /// model's indices of this part's nodes from `first` on (the split copies,
