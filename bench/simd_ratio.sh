@@ -8,6 +8,8 @@
 # "Whole step").
 #
 # Usage: RUNS=3 OUT=bench/results/simd_ratio.csv bash bench/simd_ratio.sh BUILD_A BUILD_B [BUILD...]
+#   FILTER (default 'threads:1/'): bench_step's cases, e.g. 'order:2/threads:1/'
+#   for the TET10 block alone (no TET4 block meshed: ~10 s per process).
 #   RUNS (default 3): processes per build; each meshes the blocks (~10-30 s)
 #   and runs bench_step's 1-thread cases (TET4 ~250k, TET10 ~13k elements)
 #   with 3 repetitions. One thread: TBB runs the loop on the benchmark's
@@ -20,7 +22,7 @@ runs=${RUNS:-3}
 out=${OUT:-$(cd "$(dirname "$0")" && pwd)/results/simd_ratio.csv}
 source "$(dirname "$0")/interleaved.sh"
 echo "build,run,order,load1_before,load1_after,ms_per_step,cpu_ms_per_step,M_element_steps_per_s,M_element_steps_per_cpu_s,element_loop_ms" > "$out"
-BENCH_FLAGS=(--benchmark_filter='threads:1/' --benchmark_repetitions=3)
+BENCH_FLAGS=(--benchmark_filter="${FILTER:-threads:1/}" --benchmark_repetitions=3)
 on_run() {
   /usr/bin/python3 - "$5" "$1" "$2" "$3" "$4" >> "$out" <<'PY'
 import json, sys

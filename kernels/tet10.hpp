@@ -47,18 +47,23 @@ inline Tet10Gradients tet10_shape_derivatives(const Vec3& p) {
   return d;
 }
 
+/// The 4-point rule's barycentrics: point q has L_q = a and the others b.
+inline constexpr double kTet10RuleA = 0.5854101966249685, kTet10RuleB = 0.1381966011250105;
+
 /// The 4-point rule: reference points and weights (sum of weights = 1/6).
 inline const std::array<Vec3, 4>& tet10_quadrature_points() {
-  static const double a = 0.5854101966249685, b = 0.1381966011250105;
+  constexpr double a = kTet10RuleA, b = kTet10RuleB;
   static const std::array<Vec3, 4> pts = {Vec3(b, b, b), Vec3(a, b, b), Vec3(b, a, b), Vec3(b, b, a)};
   return pts;
 }
 inline constexpr double kTet10QuadratureWeight = 1.0 / 24.0;
 
-/// Reference constants of one TET10: per quadrature point, dN/dX and
-/// weight x det(dX/dxi) (reference volume measure, m^3).
+/// Reference constants of one TET10: per quadrature point, dxi/dX = (dX/dxi)^-1
+/// and weight x det(dX/dxi) (reference volume measure, m^3). dN/dX = dN/dxi
+/// dxi/dX (tet10_gradients); the lane kernel takes dxi/dX alone (9 numbers per
+/// point instead of dN/dX's 30) and the constant dN/dxi of the rule.
 struct Tet10Reference {
-  std::array<Tet10Gradients, 4> dNdX;
+  std::array<Mat3, 4> dxi_dX;  ///< per point, (dX/dxi)^-1, 1/m
   std::array<double, 4> wdetJ;
   double volume;   ///< sum of wdetJ, m^3
   double min_jacobian;  ///< smallest det(dX/dxi) over the points (inverted if <= 0)
@@ -70,15 +75,19 @@ inline Tet10Reference tet10_reference(const Tet10Nodes& X) {
   r.min_jacobian = HUGE_VAL;
   const auto& pts = tet10_quadrature_points();
   for (int q = 0; q < 4; ++q) {
-    const Tet10Gradients dNdxi = tet10_shape_derivatives(pts[q]);
-    const Mat3 J = X * dNdxi;  // dX/dxi
+    const Mat3 J = X * tet10_shape_derivatives(pts[q]);  // dX/dxi
     const double detJ = J.determinant();
-    r.dNdX[q] = dNdxi * J.inverse();
+    r.dxi_dX[q] = J.inverse();
     r.wdetJ[q] = kTet10QuadratureWeight * detJ;
     r.volume += r.wdetJ[q];
     r.min_jacobian = std::min(r.min_jacobian, detJ);
   }
   return r;
+}
+
+/// Shape function gradients dN_a/dX (rows = nodes, 1/m) at quadrature point q.
+inline Tet10Gradients tet10_gradients(const Tet10Reference& r, int q) {
+  return tet10_shape_derivatives(tet10_quadrature_points()[q]) * r.dxi_dX[q];
 }
 
 /// The smallest scaled Jacobian of a TET10 over its quadrature points:
@@ -112,22 +121,21 @@ struct Tet10Force {
 /// element), for tet10_neo_hookean_lanes. Units as in tet10_internal_force.
 template <int N>
 struct Tet10Lanes {
-  double x[30][N];        ///< in: node positions, x[3a + i][l] = x_{a,i}, m
-  double dNdX[4][30][N];  ///< in: per point q, dN_a/dX_j at dNdX[q][3a + j][l], 1/m
-  double w[4][N];         ///< in: per point, weight x det(dX/dxi), m^3
-  double f[30][N];        ///< out: internal nodal forces dE/dx, f[3a + i][l], N
-  double energy[N];       ///< out: strain energy, J
-  double J[N];            ///< out: smallest det F over the points
-  double lnJ[N];          ///< out: ln of that J (for the wave speed without a second log)
+  double x[30][N];          ///< in: node positions, x[3a + i][l] = x_{a,i}, m
+  double dxi_dX[4][9][N];   ///< in: per point q, (dX/dxi)^-1 column-major, dxi_dX[q][3j + k][l] = dxi_k/dX_j, 1/m
+  double w[4][N];           ///< in: per point, weight x det(dX/dxi), m^3
+  double f[30][N];          ///< out: internal nodal forces dE/dx, f[3a + i][l], N
+  double energy[N];         ///< out: strain energy, J
+  double J[N];              ///< out: smallest det F over the points
+  double lnJ[N];            ///< out: ln of that J (for the wave speed without a second log)
 };
 
-/// The lanes of element e's reference constants (dN/dX and weights) into lane l.
+/// Element e's reference constants (dxi/dX and weights) into lane l.
 template <int N>
 inline void tet10_reference_into_lanes(const Tet10Reference& ref, Tet10Lanes<N>& L, int l) {
   for (int q = 0; q < 4; ++q) {
-    const double* d = ref.dNdX[q].data();  // column-major 10 x 3: dN_a/dX_j at a + 10 j
-    for (int a = 0; a < 10; ++a)
-      for (int j = 0; j < 3; ++j) L.dNdX[q][3 * a + j][l] = d[a + 10 * j];
+    const double* d = ref.dxi_dX[q].data();
+    for (int k = 0; k < 9; ++k) L.dxi_dX[q][k][l] = d[k];
     L.w[q][l] = ref.wdetJ[q];
   }
 }
@@ -136,35 +144,65 @@ inline void tet10_reference_into_lanes(const Tet10Reference& ref, Tet10Lanes<N>&
 /// written lane-wise in scalar IEEE arithmetic with a fixed order of
 /// operations (as tet4_neo_hookean_lanes), so the compiler vectorises across
 /// elements and every lane is bitwise equal to the one-lane result
-/// (tet10_internal_force with NeoHookean is this function with N = 1). Per
-/// point: F = x dN/dX, cof(F) for det F and F^-T, one log (lane_log), P = mu F +
-/// ((lambda ln J - mu) / J) cof(F), f += w P dN/dX^T.
+/// (tet10_internal_force with NeoHookean is this function with N = 1).
+///
+/// dN/dX = dN/dxi dxi/dX with dN/dxi constant per point, taken through the
+/// barycentrics: at point q, L_q = a and the three others b (the rule's
+/// points), dN_a/dL_m is (4 L_i - 1) for corner i (m = i) and 4 L_j, 4 L_i
+/// for edge (i, j) (m = i, j), and d/dxi_k = d/dL_k - d/dL_0. Per point:
+///   g_m = dx/dL_m = (4 L_m - 1) x_m + sum over the edges (m, j) of 4 L_j x_(m,j),
+///   F = [g_1 - g_0, g_2 - g_0, g_3 - g_0] dxi/dX,
+///   cof(F) for det F and F^-T, one log (lane_log), w P = w (mu F + ((lambda ln J - mu) / J) cof(F)),
+///   [h_1 h_2 h_3] = w P (dxi/dX)^T,  h_0 = -(h_1 + h_2 + h_3),
+///   f_i += (4 L_i - 1) h_i (corner i),  f_(i,j) += 4 L_j h_i + 4 L_i h_j (edge (i, j)).
+/// About 300 flops per point and 40 reference numbers per element (dN/dX
+/// itself would be 120).
 template <int N>
 inline void tet10_neo_hookean_lanes(Tet10Lanes<N>& L, const NeoHookean& mat) {
-  for (int a = 0; a < 30; ++a)
-    for (int l = 0; l < N; ++l) L.f[a][l] = 0.0;
+  for (int n = 0; n < 30; ++n)
+    for (int l = 0; l < N; ++l) L.f[n][l] = 0.0;
   for (int l = 0; l < N; ++l) L.energy[l] = 0.0, L.J[l] = HUGE_VAL, L.lnJ[l] = HUGE_VAL;
   for (int q = 0; q < 4; ++q) {
+    double c[4];  // 4 L_m at this point
+    for (int m = 0; m < 4; ++m) c[m] = 4.0 * (m == q ? kTet10RuleA : kTet10RuleB);
     double F[9][N], C[9][N], detF[N], lnJ[N];
     for (int l = 0; l < N; ++l) {
-      // F(i, j) = sum_a x_{a,i} dN_a/dX_j, F[3j + i]
-      for (int j = 0; j < 3; ++j)
+      double g[4][3];  // g[m][i] = dx_i/dL_m
+      for (int m = 0; m < 4; ++m)
+        for (int i = 0; i < 3; ++i) g[m][i] = (c[m] - 1.0) * L.x[3 * m + i][l];
+      for (int e = 0; e < 6; ++e) {
+        const int m0 = kTet10Edges[e][0], m1 = kTet10Edges[e][1];
         for (int i = 0; i < 3; ++i) {
-          double sum = L.x[i][l] * L.dNdX[q][j][l];
-          for (int a = 1; a < 10; ++a) sum += L.x[3 * a + i][l] * L.dNdX[q][3 * a + j][l];
-          F[3 * j + i][l] = sum;
+          g[m0][i] += c[m1] * L.x[3 * (4 + e) + i][l];
+          g[m1][i] += c[m0] * L.x[3 * (4 + e) + i][l];
         }
+      }
+      double D[3][3];  // D[k][i] = dx_i/dxi_k
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i) D[k][i] = g[k + 1][i] - g[0][i];
+      // F(i, j) = sum_k dx_i/dxi_k dxi_k/dX_j, F[3j + i]
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+          F[3 * j + i][l] = D[0][i] * L.dxi_dX[q][3 * j][l] + D[1][i] * L.dxi_dX[q][3 * j + 1][l] +
+                            D[2][i] * L.dxi_dX[q][3 * j + 2][l];
       detF[l] = cofactor_lane(F, C, l);
     }
     lane_log(detF, lnJ);
     for (int l = 0; l < N; ++l) {
       double P[9];  // w P, column-major
       L.energy[l] += neo_hookean_lane_stress(F, C, detF[l], lnJ[l], L.w[q][l], mat, l, P);
-      // f_{a,i} += sum_j w P(i, j) dN_a/dX_j
-      for (int n = 0; n < 10; ++n)
+      double h[4][3];  // h[k + 1][i] = sum_j w P(i, j) dxi_k/dX_j
+      for (int k = 0; k < 3; ++k)
         for (int i = 0; i < 3; ++i)
-          L.f[3 * n + i][l] += P[i] * L.dNdX[q][3 * n][l] + P[3 + i] * L.dNdX[q][3 * n + 1][l] +
-                               P[6 + i] * L.dNdX[q][3 * n + 2][l];
+          h[k + 1][i] = P[i] * L.dxi_dX[q][k][l] + P[3 + i] * L.dxi_dX[q][3 + k][l] +
+                        P[6 + i] * L.dxi_dX[q][6 + k][l];
+      for (int i = 0; i < 3; ++i) h[0][i] = -(h[1][i] + h[2][i] + h[3][i]);
+      for (int m = 0; m < 4; ++m)
+        for (int i = 0; i < 3; ++i) L.f[3 * m + i][l] += (c[m] - 1.0) * h[m][i];
+      for (int e = 0; e < 6; ++e) {
+        const int m0 = kTet10Edges[e][0], m1 = kTet10Edges[e][1];
+        for (int i = 0; i < 3; ++i) L.f[3 * (4 + e) + i][l] += c[m1] * h[m0][i] + c[m0] * h[m1][i];
+      }
       const bool smaller = detF[l] < L.J[l];  // as std::min: a NaN point is skipped
       L.lnJ[l] = smaller ? lnJ[l] : L.lnJ[l];
       L.J[l] = smaller ? detF[l] : L.J[l];
@@ -196,11 +234,12 @@ inline Tet10Force tet10_internal_force(const Tet10Nodes& x, const Tet10Reference
     out.energy = 0.0;
     out.J = HUGE_VAL;
     for (int q = 0; q < 4; ++q) {
-      const Mat3 F = x * ref.dNdX[q];
+      const Tet10Gradients dNdX = tet10_gradients(ref, q);
+      const Mat3 F = x * dNdX;
       Mat3 P;
       double W;
       mat.stress_energy(F, P, W);
-      out.f.noalias() += ref.wdetJ[q] * P * ref.dNdX[q].transpose();
+      out.f.noalias() += ref.wdetJ[q] * P * dNdX.transpose();
       out.energy += ref.wdetJ[q] * W;
       out.J = std::min(out.J, F.determinant());
     }

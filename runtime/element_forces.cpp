@@ -313,7 +313,7 @@ void element_cauchy_stress6(const Model& model, std::span<const Vec3> x, Index e
   } else {
     Tet10Nodes xe;
     for (int a = 0; a < 10; ++a) xe.col(a) = x[c[a]];
-    for (int q = 0; q < 4; ++q) s += 0.25 * m.cauchy_stress(xe * model.tet10_ref[e].dNdX[q]);
+    for (int q = 0; q < 4; ++q) s += 0.25 * m.cauchy_stress(xe * tet10_gradients(model.tet10_ref[e], q));
   }
   o[0] = s(0, 0), o[1] = s(1, 1), o[2] = s(2, 2), o[3] = s(1, 2), o[4] = s(0, 2), o[5] = s(0, 1);
 }

@@ -27,7 +27,7 @@ struct Model {
 
   // Per-element reference constants (struct of arrays; one set per order).
   std::vector<Mat3> tet4_Dm_inv;             ///< TET4: inverse reference edge matrix, 1/m
-  std::vector<Tet10Reference> tet10_ref;     ///< TET10: dN/dX and weights per point
+  std::vector<Tet10Reference> tet10_ref;     ///< TET10: dxi/dX and weights per point
   std::vector<double> element_volume;        ///< reference volume, m^3
   std::vector<double> element_node_mass;     ///< [e*k + a]: lumped mass element e gives node a, kg
 

@@ -66,7 +66,7 @@ TEST(Tet10, ExactForQuadraticFields) {
   for (int q = 0; q < 4; ++q) {
     const Vec3 Xq = X * tet10_shape(pts[q]);
     EXPECT_NEAR(un.dot(tet10_shape(pts[q])), u(Xq), 1e-13);
-    const Vec3 grad = ref.dNdX[q].transpose() * un;
+    const Vec3 grad = tet10_gradients(ref, q).transpose() * un;
     EXPECT_LT((grad - (2 * A * Xq + b)).norm(), 1e-12);
   }
   EXPECT_CLOSE(ref.volume, tet_signed_volume(kCorners[0], kCorners[1], kCorners[2], kCorners[3]), 1e-14, 0);
@@ -139,7 +139,7 @@ TEST(Tet, AffineMotionGivesUniformStressAndZeroNetForce) {
   const Tet10Nodes X = straight_tet10(kCorners);
   const Tet10Reference r10 = tet10_reference(X);
   const Tet10Nodes x10 = (G * X).colwise() + t;
-  for (int q = 0; q < 4; ++q) EXPECT_LT((x10 * r10.dNdX[q] - G).norm(), 1e-14);
+  for (int q = 0; q < 4; ++q) EXPECT_LT((x10 * tet10_gradients(r10, q) - G).norm(), 1e-14);
 }
 
 TEST(Tet4, MinAltitude) {
@@ -159,19 +159,22 @@ TEST(Tet, LaneKernelsGiveEachElementItsOneElementBits) {
   std::uniform_real_distribution<double> u(-0.1, 0.1);
   const Tet4Reference r4 = tet4_reference(kCorners[0], kCorners[1], kCorners[2], kCorners[3]);
   const Tet10Nodes X = straight_tet10(kCorners);
-  const Tet10Reference r10 = tet10_reference(X);
+  std::array<Tet10Reference, N> r10;  // lane l: one curved edge, so dxi/dX differs by point and lane
   std::array<Tet10Nodes, N> x;
   Tet4Lanes<N> L4;
   Tet10Lanes<N> L10;
   for (int l = 0; l < N; ++l) {
+    Tet10Nodes Xl = X;
+    Xl.col(4 + l % 6) += Vec3(u(rng), u(rng), u(rng));
+    r10[l] = tet10_reference(Xl);
     const double s = std::pow(1.45, l - 3);  // volume ratio s^3
-    x[l] = s * X;
+    x[l] = s * Xl;
     for (int a = 0; a < 10; ++a) x[l].col(a) += Vec3(u(rng), u(rng), u(rng));
     for (int q = 0; q < 12; ++q) L4.x[q][l] = x[l].data()[q];
     for (int q = 0; q < 9; ++q) L4.Dm_inv[q][l] = r4.Dm_inv.data()[q];
     L4.V0[l] = r4.volume;
     for (int q = 0; q < 30; ++q) L10.x[q][l] = x[l].data()[q];
-    tet10_reference_into_lanes(r10, L10, l);
+    tet10_reference_into_lanes(r10[l], L10, l);
   }
   tet4_neo_hookean_lanes(L4, kMat);
   tet10_neo_hookean_lanes(L10, kMat);
@@ -184,8 +187,36 @@ TEST(Tet, LaneKernelsGiveEachElementItsOneElementBits) {
     for (int q = 0; q < 30; ++q) f10[q] = L10.f[q][l];
     EXPECT_TRUE(same(f4, one4.f.data(), 12)) << "TET4 lane " << l;
     EXPECT_TRUE(same(&L4.energy[l], &one4.energy, 1) && same(&L4.J[l], &one4.J, 1)) << "TET4 lane " << l;
-    const auto one10 = tet10_internal_force(x[l], r10, kMat);
+    const auto one10 = tet10_internal_force(x[l], r10[l], kMat);
     EXPECT_TRUE(same(f10, one10.f.data(), 30)) << "TET10 lane " << l;
     EXPECT_TRUE(same(&L10.energy[l], &one10.energy, 1) && same(&L10.J[l], &one10.J, 1)) << "TET10 lane " << l;
   }
+}
+
+TEST(Tet10, LaneKernelIsTheGradientFormula) {
+  // The lane kernel takes dN/dX = dN/dxi dxi/dX through the barycentrics
+  // (kernels/tet10.hpp); the textbook form f_a = sum_q w_q P(F_q) dN_a/dX,
+  // F_q = x dN/dX (Eigen, NeoHookean::stress) must agree to round-off, on a
+  // curved element under a large deformation.
+  Tet10Nodes X = straight_tet10(kCorners);
+  X.col(5) += Vec3(0.02, 0.03, -0.01);
+  X.col(7) += Vec3(-0.015, 0.01, 0.02);
+  const Tet10Reference ref = tet10_reference(X);
+  std::mt19937_64 rng(10);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  Tet10Nodes x = 1.3 * X;
+  for (int a = 0; a < 10; ++a) x.col(a) += Vec3(u(rng), u(rng), u(rng));
+  Eigen::Matrix<double, 3, 10> f = Eigen::Matrix<double, 3, 10>::Zero();
+  double energy = 0, J = HUGE_VAL;
+  for (int q = 0; q < 4; ++q) {
+    const Tet10Gradients dNdX = tet10_gradients(ref, q);
+    const Mat3 F = x * dNdX;
+    f += ref.wdetJ[q] * kMat.stress(F) * dNdX.transpose();
+    energy += ref.wdetJ[q] * kMat.energy(F);
+    J = std::min(J, F.determinant());
+  }
+  const Tet10Force lanes = tet10_internal_force(x, ref, kMat);
+  EXPECT_LT((lanes.f - f).norm(), 1e-13 * f.norm());
+  EXPECT_NEAR(lanes.energy, energy, 1e-13 * std::abs(energy));
+  EXPECT_NEAR(lanes.J, J, 1e-14 * J);
 }
