@@ -4,7 +4,8 @@
 # --parts DIR` reads on each rank its own part and meshes nothing. Checks:
 #   - the outputs (history.csv, bodies.csv, fragments.csv) are byte-equal to
 #     the 1-rank run's, for a scene without contact or fracture at 2 and 3
-#     ranks, a contact scene and a fragmenting one at 3;
+#     ranks, a contact scene and a fragmenting one at 3, and a run stopped
+#     half way and restarted from its checkpoint, both from part files;
 #   - no rank holds the whole model at start-up: with parts the start-up
 #     rank peaks within 1.15x of the other ranks (without parts, where it
 #     meshes and cuts the whole model, it does not: checked too, so that
@@ -37,6 +38,13 @@ same_as_one_rank "$scenes/pulled_bar.yaml" 2 history.csv bodies.csv
 same_as_one_rank "$scenes/pulled_bar.yaml" 3 history.csv bodies.csv
 same_as_one_rank "$scenes/five_cubes_friction.yaml" 3 history.csv bodies.csv
 same_as_one_rank "$scenes/expanding_ring.yaml" 3 history.csv bodies.csv fragments.csv
+# A restart from part files: stopped half way (a checkpoint at step 1000), continued.
+mpi 3 run "$scenes/pulled_bar.yaml" --parts parts_pulled_bar --out restarted --threads 1 --quiet \
+  --set time.end=3e-5 --set "checkpoint={every_steps: 1000}"
+mpi 3 run "$scenes/pulled_bar.yaml" --parts parts_pulled_bar --restart restarted/checkpoint.h5 --threads 1 --quiet
+for f in history.csv bodies.csv; do
+  cmp -s r1_pulled_bar/$f restarted/$f || fail "pulled_bar restarted from part files: $f differs from 1 rank's"
+done
 grep -q '"contact_pairs_per_step_rank_min": [1-9]' p3_five_cubes_friction/summary.json ||
   fail "five_cubes_friction from part files: a rank of 3 resolved no contact pair (the comparison does not cover contact)"
 
