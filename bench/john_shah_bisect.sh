@@ -24,8 +24,11 @@
 #          region, crack heights at the end, energy error, end time, wall and
 #          CPU seconds, load average before and after) and the switch
 #          interval on stdout.
-# Expect:  1-3 minutes of wall per run at h = 8 mm with --threads 1 on a
-#          loaded 2-core machine (5 900 TET4, ~23 000 steps, ~15 s of CPU).
+# Expect:  per run, --threads 1, load average 5-12 on 2 cores: h = 8 mm
+#          (6 000 TET4, 25 000 steps) 15 s of CPU, 0.5-1.5 min of wall;
+#          5 mm 1 min of CPU, 2 of wall; 4 mm 2 min of CPU, 3 of wall. The
+#          switch: gamma 0.678-0.683 at 8 mm, 0.641-0.645 at 5 mm,
+#          0.636-0.641 at 4 mm (docs/validation.md).
 set -euo pipefail
 build=${1:?usage: john_shah_bisect.sh BUILD_DIR [RUN_DIR]}
 runs=${2:-/tmp/john_shah_runs}
