@@ -15,7 +15,8 @@
 # the script fails if either disagrees. GAMMAS="g1 g2 ..." runs only those
 # (no bisection; e.g. H=5.0e-3 GAMMAS="0.7625 0.78" for the mesh check).
 # Run:     bash bench/john_shah_bisect.sh BUILD_DIR [RUN_DIR]
-#          (RUN_DIR keeps every run; a run already there is reused;
+#          (RUN_DIR keeps every run; a run of the same gamma, H and END
+#          already there is reused;
 #          default /tmp/john_shah_runs; env STEPS=6 H=8.0e-3 END=1.2e-3
 #          ENDS=1 GAMMAS=)
 # Output:  bench/results/john_shah_bisect_h<H>.csv (john_shah_gammas_h<H>.csv
@@ -65,7 +66,7 @@ scene() {
 # judge_run GAMMA: run (or reuse) this gamma, add its row to the table, print its crack.
 judge_run() {
   local g=$1 tag dir sc verdict l0
-  tag="g${g}_h$h"
+  tag="g${g}_h${h}_end$end"
   dir="$runs/$tag"
   sc=$(scene "$g" "$tag")
   if [ ! -f "$dir/summary.json" ]; then
