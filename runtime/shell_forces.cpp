@@ -58,6 +58,7 @@ ShellForces::ShellForces(const Model& model) : model_(model) {
     patch_dt_.emplace_back(patches, HUGE_VAL);
     elements_ += patches;
   }
+  owned_elements_ = elements_;
 }
 
 void ShellForces::restrict_to(std::span<const Index> touched, const std::function<bool(Index)>& owns) {
@@ -65,7 +66,7 @@ void ShellForces::restrict_to(std::span<const Index> touched, const std::functio
   for (const Index n : touched) is_touched[n] = 1;
   const ShellPatchNodes patch_nodes = shell_patch_nodes(model_.shells);
   Index patch = 0;  // over every body's patches, in shell_patch_nodes' order
-  elements_ = 0;
+  elements_ = owned_elements_ = 0;
   for (std::size_t b = 0; b < model_.shells.size(); ++b) {
     const ShellBody& s = model_.shells[b];
     for (std::size_t k = 0; k < s.sets.size(); ++k) {
@@ -77,6 +78,7 @@ void ShellForces::restrict_to(std::span<const Index> touched, const std::functio
         if (std::any_of(nodes.begin(), nodes.end(), [&](Index n) { return n >= 0 && is_touched[n]; }))
           computed.push_back(p);
         triangle_owned_[b][set.triangle[p]] = owns(s.first_node + s.mesh.triangles[set.triangle[p]][0]) ? 1 : 0;
+        owned_elements_ += triangle_owned_[b][set.triangle[p]];
       }
       elements_ += static_cast<Index>(computed.size());
     }

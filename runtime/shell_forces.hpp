@@ -48,12 +48,14 @@ class ShellForces {
   /// Whether the patch of triangle t of shell body b is owned here (every one unless restricted).
   bool owns_triangle(std::size_t b, Index t) const { return triangle_owned_[b][t] != 0; }
 
-  /// Shell elements computed per call.
+  /// Shell elements computed per call (owned and ghost patches).
   Index elements() const { return elements_; }
+  /// Shell elements whose energy is counted here (owned patches).
+  Index owned_elements() const { return owned_elements_; }
 
  private:
   const Model& model_;
-  Index elements_ = 0;
+  Index elements_ = 0, owned_elements_ = 0;
   /// Per shell body: per set, the patches computed; the vertices whose
   /// forces are written; per triangle, 1 when its patch's energy is counted here.
   std::vector<std::vector<std::vector<Index>>> computed_;

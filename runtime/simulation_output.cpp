@@ -235,7 +235,8 @@ long Simulation::loop_bytes() const {
 }
 
 void Simulation::write_summary(double wall, const DecompositionStats& stats, const ContactBalance& contact_balance,
-                               const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory) {
+                               const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory,
+                               const std::array<long, 3>& shell) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -262,6 +263,15 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("local_elements_max", stats.local_max);
   j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
+  if (shells_) {
+    // Shell patches (docs/parallel.md "Shells on ranks"): the whole count, owned and computed per rank.
+    long triangles = 0;
+    for (const ShellBody& s : model_.shells) triangles += s.mesh.num_triangles();
+    j.add("shell_elements", triangles);
+    j.add("shell_owned_elements_min", shell[0]);
+    j.add("shell_owned_elements_max", shell[1]);
+    j.add("shell_local_elements_max", shell[2]);
+  }
   // No contact surface state goes to every rank any more (the patches, docs/parallel.md).
   j.add("shared_surface_bytes_per_step", 0L);
   // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
