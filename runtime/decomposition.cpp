@@ -7,6 +7,7 @@
 
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
+#include "mesh/reorder.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
 #include "runtime/row_blocks.hpp"
@@ -14,6 +15,21 @@
 
 namespace shatter {
 namespace {
+
+/// The position of each point along the Morton curve of the cube of their
+/// largest extent, from their lower corner (ties in index order).
+std::vector<Index> morton_positions(std::span<const Vec3> points) {
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  for (const Vec3& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const double extent = (hi - lo).maxCoeff();
+  std::vector<std::pair<std::uint64_t, Index>> code(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    code[i] = {morton_code(points[i], lo, lo + Vec3::Constant(extent)), static_cast<Index>(i)};
+  std::sort(code.begin(), code.end());
+  std::vector<Index> position(points.size());
+  for (size_t k = 0; k < code.size(); ++k) position[code[k].second] = static_cast<Index>(k);
+  return position;
+}
 
 }  // namespace
 
@@ -41,9 +57,10 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
     shell_patches_ = shell_patch_nodes(model.shells);
     first_shell_node_ = model.shells.front().first_node;
     shell_nodes_ = shell_vertices(model.shells);
+    shell_position_ = morton_positions(std::span<const Vec3>(mesh.reference).subspan(first_shell_node_, shell_nodes_));
     std::vector<Index> items = shell_patches_.nodes;
     for (Index& n : items)
-      if (n >= 0) n -= first_shell_node_;
+      if (n >= 0) n = shell_position_[n - first_shell_node_];
     const std::vector<int> part =
         partition_item_granules(shell_nodes_, items, shell_patches_.width, kShellGranule, size_);
     granule_rank_.insert(granule_rank_.end(), part.begin(), part.end());
@@ -93,7 +110,7 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
   // it is owned here, so neither is the granule computed; a contact-surface
   // node outside the part's elements has no star and no home granule (-1).
   for (Index n = 0; n < nn; ++n)
-    home_granule_[n] = is_shell_node(n) ? first_shell_granule_ + (n - first_shell_node_) / kShellGranule
+    home_granule_[n] = is_shell_node(n) ? first_shell_granule_ + shell_position_[n - first_shell_node_] / kShellGranule
                        : mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
                            ? -1
                            : model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;

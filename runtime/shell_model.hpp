@@ -24,7 +24,8 @@ namespace shatter {
 inline constexpr int kShellPoints = 3;
 /// Shell control vertices per granule (docs/parallel.md "Shells on ranks"):
 /// the unit of their ownership between MPI ranks and of their terms in
-/// global sums, kShellGranule consecutive vertices over all shell bodies.
+/// global sums, kShellGranule vertices of all shell bodies consecutive along
+/// a Morton curve of their reference positions (runtime/decomposition.cpp).
 inline constexpr Index kShellGranule = 32;
 /// The valences of an extraordinary corner the runtime has element sets for.
 inline constexpr int kShellMinValence = 3, kShellMaxValence = 12;
