@@ -50,9 +50,10 @@ void print_check(const Model& model, const Simulation& sim) {
   std::vector<long> count(2 * nb, 0);  // per body: nodes, elements
   for (Index i : d.owned_nodes()) ++count[2 * mesh.node_body[i]];
   for (Index e : d.owned_element_ids()) ++count[2 * mesh.elem_body[e] + 1];
-  long shell_triangles = 0;  // a shell body's elements: its control triangles (one rank)
+  // A shell body's elements: its control triangles, which every rank holds (rank 0 counts them).
+  long shell_triangles = 0;
   for (const ShellBody& sb : model.shells) {
-    count[2 * sb.body + 1] += sb.mesh.num_triangles();
+    if (d.rank() == 0) count[2 * sb.body + 1] += sb.mesh.num_triangles();
     shell_triangles += sb.mesh.num_triangles();
   }
   count = d.sum(count);

@@ -23,6 +23,16 @@ namespace shatter {
 /// Throws Error when parts < 1, or parts > 1 and parts > granules.
 std::vector<int> partition_granules(const Mesh& mesh, Index granule, int parts, int seed = 1);
 
+/// Part of every granule of `granule` consecutive items (granule g = items
+/// [g granule, (g+1) granule)) of `items` items linked by groups of `width`
+/// item ids (-1: none), such as the control vertices of shell patches:
+/// METIS_PartGraphKway as partition_granules, two granules adjacent when a
+/// group holds items of both, edge weight = number of such groups, vertex
+/// weight = items. Deterministic in the same way; no part is empty.
+/// Throws Error when parts < 1, or parts > 1 and parts > granules.
+std::vector<int> partition_item_granules(Index items, std::span<const Index> groups, int width, Index granule,
+                                         int parts, int seed = 1);
+
 /// CSR of the sorted, distinct parts of the elements around each node
 /// (the ranks touching it): ranks of node n are ranks[offsets[n] .. offsets[n+1]).
 struct NodeRanks {

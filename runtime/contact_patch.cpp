@@ -31,13 +31,21 @@ Box empty_box() {
 }  // namespace
 
 SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
-                          double margin) {
+                          double margin, std::span<const double> reach) {
   SweptBoxes boxes = swept_boxes(surface, x_old, x_new);
   for (auto* list : {&boxes.triangles, &boxes.edges, &boxes.vertices})
     for (Box& b : *list) {
       b.lo.array() -= 1.01 * margin;
       b.hi.array() += 1.01 * margin;
     }
+  if (reach.empty()) return boxes;
+  auto grow = [&](Box& b, Index node) {
+    b.lo.array() -= reach[node];
+    b.hi.array() += reach[node];
+  };
+  for (size_t t = 0; t < boxes.triangles.size(); ++t) grow(boxes.triangles[t], surface.triangles[t][0]);
+  for (size_t e = 0; e < boxes.edges.size(); ++e) grow(boxes.edges[e], surface.edges[e][0]);
+  for (size_t v = 0; v < boxes.vertices.size(); ++v) grow(boxes.vertices[v], surface.vertices[v]);
   return boxes;
 }
 
@@ -90,10 +98,11 @@ bool ContactPatch::owns(Index q) const {
                 : std::binary_search(owned_edges_.begin(), owned_edges_.end(), q - nt);
 }
 
-void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
+void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
+                         std::span<const double> thickness) {
   const int ranks = dec_.size(), me = dec_.rank();
-  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin);
-  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin);
+  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin, thickness);
+  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, thickness);
   Box mine = empty_box();
   for (const auto* list : {&own.triangles, &own.edges})
     for (const Box& b : *list) {

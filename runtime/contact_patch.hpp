@@ -28,9 +28,11 @@ class Halo;
 
 /// Swept boxes of a surface's primitives from x_old to x_new (swept_boxes), each grown by
 /// 1.01 margin on every side: the boxes of a search whose candidates serve while every node
-/// stays within margin (ContactStage, "Candidate reuse").
+/// stays within margin (ContactStage, "Candidate reuse"); then, with `reach` (per node: a
+/// shell node's half-thickness, else 0), by the reach of the primitive's first node (a
+/// shell's primitives are thick: docs/shells.md "Contact").
 SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
-                          double margin);
+                          double margin, std::span<const double> reach = {});
 
 /// Which nodes' states ContactPatch::exchange brings: the owned primitives' (own()), the
 /// patch's (reach()) or the candidates' (activate()).
@@ -65,7 +67,9 @@ class ContactPatch {
   /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
   /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
   /// reach here; their nodes are PatchPlan::Patch. Collective.
-  void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
+  /// `thickness`: the nodes' reach (inflated_boxes), empty without shells.
+  void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
+             std::span<const double> thickness = {});
   /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates)
   /// and of the triangles around them, whose normals orient the pairs. Collective.
   void activate(std::span<const ContactPair> pairs);

@@ -31,7 +31,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
   self_ = spec.self;
   for (const BodySpec& b : model.scene.bodies) free_rigid_.push_back(b.free_rigid);
   any_free_rigid_ = std::find(free_rigid_.begin(), free_rigid_.end(), char{1}) != free_rigid_.end();
-  // Shells (one rank): their control nodes' half-thickness; a shell never contacts itself.
+  // Shells: their control nodes' half-thickness; a shell never contacts itself.
   shell_body_.assign(model.scene.bodies.size(), 0);
   for (const ShellBody& shell : model.shells) {
     reach_.resize(model.mesh.num_nodes(), 0.0);
@@ -142,25 +142,13 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
     search_patch(x_old, x_new, v);
   } else {
     const double cpu0 = thread_cpu_seconds();
-    SweptBoxes boxes = inflated_boxes(surface_, x_old, x_new, margin_);
-    if (!reach_.empty()) thicken_boxes(boxes);
-    pairs_ = find_candidates(surface_, boxes);
+    pairs_ = find_candidates(surface_, inflated_boxes(surface_, x_old, x_new, margin_, reach_));
     std::erase_if(pairs_, [&](const ContactPair& p) { return excluded(p); });
     profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
   }
   x_search_.assign(x_new.begin(), x_new.end());
   have_candidates_ = true;
   ++profile_.searches;
-}
-
-void ContactStage::thicken_boxes(SweptBoxes& boxes) const {
-  auto grow = [&](Box& b, Index node) {
-    b.lo.array() -= reach_[node];
-    b.hi.array() += reach_[node];
-  };
-  for (size_t t = 0; t < boxes.triangles.size(); ++t) grow(boxes.triangles[t], surface_.triangles[t][0]);
-  for (size_t e = 0; e < boxes.edges.size(); ++e) grow(boxes.edges[e], surface_.edges[e][0]);
-  for (size_t v = 0; v < boxes.vertices.size(); ++v) grow(boxes.vertices[v], surface_.vertices[v]);
 }
 
 void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
@@ -199,10 +187,10 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
       repartition_ = false;
       ++profile_.repartitions;
     }
-    patch_->reach(x_old, x_new, margin_);
+    patch_->reach(x_old, x_new, margin_, reach_);
     exchange(x_old, x_new, v, PatchPlan::Patch);
     const double cpu0 = thread_cpu_seconds();
-    const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_));
+    const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_, reach_));
     // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);

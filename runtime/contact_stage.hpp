@@ -137,9 +137,6 @@ class ContactStage {
   bool excluded(const ContactPair& p) const;
   /// Whether excluded() reads the pairs' bodies (node_body_).
   bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }
-  /// Grows each shell primitive's box by its half-thickness (reach_), so that the search finds
-  /// the pairs of thick sides within h = r_1 + r_2 (pair_boxes_overlap with reach).
-  void thicken_boxes(SweptBoxes& boxes) const;
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
@@ -169,7 +166,7 @@ class ContactStage {
   bool any_free_rigid_ = false;
   std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false, or shells)
   std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
-  std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells
+  std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells (grows the search boxes: inflated_boxes)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;

@@ -7,12 +7,29 @@
 
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
+#include "mesh/reorder.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
 #include "runtime/row_blocks.hpp"
+#include "runtime/shell_model.hpp"
 
 namespace shatter {
 namespace {
+
+/// The position of each point along the Morton curve of the cube of their
+/// largest extent, from their lower corner (ties in index order).
+std::vector<Index> morton_positions(std::span<const Vec3> points) {
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  for (const Vec3& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const double extent = (hi - lo).maxCoeff();
+  std::vector<std::pair<std::uint64_t, Index>> code(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    code[i] = {morton_code(points[i], lo, lo + Vec3::Constant(extent)), static_cast<Index>(i)};
+  std::sort(code.begin(), code.end());
+  std::vector<Index> position(points.size());
+  for (size_t k = 0; k < code.size(); ++k) position[code[k].second] = static_cast<Index>(k);
+  return position;
+}
 
 }  // namespace
 
@@ -29,14 +46,25 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
     granule_rank_ = model.part.granule_rank;
   } else {
     check_ranks(model, size_);
-    granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
+    // A model of shells alone has no element granules.
+    if (mesh.num_elements() > 0) granule_rank_ = partition_granules(mesh, ElementForces::kGranule, size_);
   }
-  // Shell nodes (on one rank, model.cpp): granules of their own, past the elements'.
+  // Shell control vertices: granules of kShellGranule vertices of their own,
+  // past the elements', partitioned by their patches (docs/parallel.md
+  // "Shells on ranks").
   first_shell_granule_ = num_granules();
-  if (!model.shells.empty())
-    granule_rank_.resize(first_shell_granule_ + (mesh.num_nodes() - model.shells.front().first_node +
-                                                 ElementForces::kGranule - 1) / ElementForces::kGranule,
-                         0);
+  if (!model.shells.empty()) {
+    shell_patches_ = shell_patch_nodes(model.shells);
+    first_shell_node_ = model.shells.front().first_node;
+    shell_nodes_ = shell_vertices(model.shells);
+    shell_position_ = morton_positions(std::span<const Vec3>(mesh.reference).subspan(first_shell_node_, shell_nodes_));
+    std::vector<Index> items = shell_patches_.nodes;
+    for (Index& n : items)
+      if (n >= 0) n = shell_position_[n - first_shell_node_];
+    const std::vector<int> part =
+        partition_item_granules(shell_nodes_, items, shell_patches_.width, kShellGranule, size_);
+    granule_rank_.insert(granule_rank_.end(), part.begin(), part.end());
+  }
   for (Index g = 0; g < num_granules(); ++g)
     if (granule_rank_[g] == rank_) owned_granules_.push_back(g);
   for (Index e = 0; e < mesh.num_elements(); ++e)
@@ -49,11 +77,17 @@ Decomposition::~Decomposition() = default;
 
 void check_ranks(const Model& model, int ranks) {
   const Index ne = model.whole_elements(), ng = (ne + ElementForces::kGranule - 1) / ElementForces::kGranule;
-  if (ranks > 1 && ranks > ng)
+  if (ranks > 1 && ne > 0 && ranks > ng)
     throw InputError(model.scene.file + ": the mesh has " + std::to_string(ne) + " elements, " +
                      std::to_string(ng) + (ng == 1 ? " granule of " : " granules of ") + std::to_string(ElementForces::kGranule) +
                      "; it cannot be shared by " + std::to_string(ranks) + " MPI ranks (use at most " +
                      std::to_string(ng) + ")");
+  const Index nv = shell_vertices(model.shells), nsg = (nv + kShellGranule - 1) / kShellGranule;
+  if (ranks > 1 && nv > 0 && ranks > nsg)
+    throw InputError(model.scene.file + ": the shells have " + std::to_string(nv) + " control vertices, " +
+                     std::to_string(nsg) + (nsg == 1 ? " granule of " : " granules of ") + std::to_string(kShellGranule) +
+                     "; they cannot be shared by " + std::to_string(ranks) + " MPI ranks (use at most " +
+                     std::to_string(nsg) + ")");
 }
 
 NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_rank,
@@ -75,9 +109,8 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
   // On a part, a ghost-only node's star may not be whole here, but none of
   // it is owned here, so neither is the granule computed; a contact-surface
   // node outside the part's elements has no star and no home granule (-1).
-  const Index first_shell_node = model_.shells.empty() ? nn : model_.shells.front().first_node;
   for (Index n = 0; n < nn; ++n)
-    home_granule_[n] = n >= first_shell_node ? first_shell_granule_ + (n - first_shell_node) / ElementForces::kGranule
+    home_granule_[n] = is_shell_node(n) ? first_shell_granule_ + shell_position_[n - first_shell_node_] / kShellGranule
                        : mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
                            ? -1
                            : model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
@@ -121,6 +154,18 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     node_rank_offsets_ = std::move(touch.offsets);
     node_ranks_ = std::move(touch.ranks);
   }
+  if (shell_nodes_ > 0) {
+    // A shell node (in no element) is touched by the owner of its granule alone.
+    std::vector<Index> offsets(nn + 1, 0);
+    std::vector<int> ranks;
+    for (Index n = 0; n < nn; ++n) {
+      if (is_shell_node(n)) ranks.push_back(granule_rank_[home_granule_[n]]);
+      else ranks.insert(ranks.end(), node_ranks_.begin() + node_rank_offsets_[n], node_ranks_.begin() + node_rank_offsets_[n + 1]);
+      offsets[n + 1] = static_cast<Index>(ranks.size());
+    }
+    node_rank_offsets_ = std::move(offsets);
+    node_ranks_ = std::move(ranks);
+  }
   auto touches = [&](Index n, int r) {
     return std::binary_search(node_ranks_.begin() + node_rank_offsets_[n],
                               node_ranks_.begin() + node_rank_offsets_[n + 1], r);
@@ -138,6 +183,20 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     if (!local) continue;
     local_elements_.push_back(e);
     for (int a = 0; a < k; ++a) held[mesh.element(e)[a]] = 1;
+  }
+  // The shell patches are groups too: a rank computes every patch with a
+  // node it touches, and holds (receives) the patch's other nodes.
+  std::vector<Index> all_groups;
+  if (shell_patches_.patches() > 0) {
+    const int width = std::max(group_width, shell_patches_.width);
+    all_groups.assign((groups.size() / group_width + shell_patches_.patches()) * width, -1);
+    Index g = 0;
+    for (size_t i = 0; i < groups.size(); i += group_width, ++g)
+      std::copy_n(groups.begin() + i, group_width, all_groups.begin() + g * width);
+    for (Index p = 0; p < shell_patches_.patches(); ++p, ++g)
+      std::copy_n(shell_patches_.of(p).begin(), shell_patches_.width, all_groups.begin() + g * width);
+    groups = all_groups;
+    group_width = width;
   }
   // The groups around each node (CSR), and the nodes of the groups with a touched node.
   const Index ng = static_cast<Index>(groups.size() / group_width);

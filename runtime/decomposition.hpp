@@ -27,9 +27,13 @@
 // the ranks by one reduction of constant size (sum()). The result is the
 // same double on every rank and for any decomposition and thread count.
 // With one rank (or MPI not initialised) nothing is communicated. Shell
-// nodes (one rank only, runtime/shell_model.hpp) are in no element: they
-// have granules of their own, of ElementForces::kGranule consecutive shell
-// nodes, after the elements' granules.
+// nodes (runtime/shell_model.hpp; the whole model on every rank) are in no
+// element: they have granules of their own, of kShellGranule shell nodes
+// consecutive along a Morton curve, after the elements' granules,
+// partitioned by METIS over the shell patches; the owner of its granule alone touches a shell node, and
+// the shell patches are node groups (rebuild_nodes): a rank computes every
+// patch with a node it touches and receives the patch's other nodes (the
+// 2-ring ghost layer).
 #include <mpi.h>
 
 #include <memory>
@@ -42,6 +46,7 @@
 #include "runtime/element_forces.hpp"
 #include "runtime/model.hpp"
 #include "runtime/parallel.hpp"
+#include "runtime/shell_model.hpp"
 
 namespace shatter {
 
@@ -174,9 +179,16 @@ class Decomposition {
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0, size_ = 1;
   std::vector<int> granule_rank_;
-  /// The first granule of the shell nodes (kGranule consecutive shell nodes
-  /// each, past the elements' granules; a shell node's home granule).
+  /// The first granule of the shell nodes (kShellGranule shell nodes each,
+  /// past the elements' granules; a shell node's home granule).
   Index first_shell_granule_ = 0;
+  Index first_shell_node_ = 0, shell_nodes_ = 0;
+  /// Per shell node (from first_shell_node_): its position along the Morton
+  /// curve of the shells' reference positions; granule g holds positions
+  /// [g kShellGranule, (g+1) kShellGranule), so a granule is a compact piece of a shell.
+  std::vector<Index> shell_position_;
+  ShellPatchNodes shell_patches_;  ///< the nodes of every shell patch (groups of rebuild_nodes)
+  bool is_shell_node(Index n) const { return n >= first_shell_node_ && n < first_shell_node_ + shell_nodes_; }
   std::vector<Index> owned_granules_;
   Index owned_elements_ = 0;
   std::vector<Index> node_rank_offsets_;

@@ -364,16 +364,18 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
   expect_size("shell_bending_moment", sh.bending_moment.size(), 6 * sh.triangles.size());
   require_all(error.str(), s.comm);
 
-  // Global placement: [0] nodes, [1] elements.
-  const std::array<long long, 2> local{static_cast<long long>(n), static_cast<long long>(e)};
-  std::array<long long, 2> offset{0, 0}, total{0, 0};
-  MPI_Exscan(local.data(), offset.data(), 2, MPI_LONG_LONG, MPI_SUM, s.comm);
-  if (s.rank == 0) offset = {0, 0};
-  MPI_Allreduce(local.data(), total.data(), 2, MPI_LONG_LONG, MPI_SUM, s.comm);
-  const Rows node_rows{static_cast<hsize_t>(n), static_cast<hsize_t>(offset[0]),
-                       static_cast<hsize_t>(total[0])};
-  const Rows elem_rows{static_cast<hsize_t>(e), static_cast<hsize_t>(offset[1]),
-                       static_cast<hsize_t>(total[1])};
+  // Global placement: [0] nodes, [1] elements, [2] shell vertices, [3] shell triangles.
+  const std::array<long long, 4> local{static_cast<long long>(n), static_cast<long long>(e),
+                                       static_cast<long long>(sh.reference.size()),
+                                       static_cast<long long>(sh.triangles.size())};
+  std::array<long long, 4> offset{0, 0, 0, 0}, total{0, 0, 0, 0};
+  MPI_Exscan(local.data(), offset.data(), 4, MPI_LONG_LONG, MPI_SUM, s.comm);
+  if (s.rank == 0) offset = {0, 0, 0, 0};
+  MPI_Allreduce(local.data(), total.data(), 4, MPI_LONG_LONG, MPI_SUM, s.comm);
+  auto rows = [&](int i) {
+    return Rows{static_cast<hsize_t>(local[i]), static_cast<hsize_t>(offset[i]), static_cast<hsize_t>(total[i])};
+  };
+  const Rows node_rows = rows(0), elem_rows = rows(1), vertex_rows = rows(2), triangle_rows = rows(3);
 
   const int changed_local = s.mesh_count == 0 || mesh.revision != s.mesh_revision ||
                             order != s.mesh_order || total[0] != s.mesh_nodes ||
@@ -404,10 +406,7 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
     // A model of shells alone has no element datasets (fields.xdmf names none).
     if (total[1] > 0)
       write_rows(group.get(), "topology", H5T_NATIVE_INT64, H5T_STD_I64LE, topology.data(), elem_rows, k);
-    if (!sh.triangles.empty()) {
-      // One rank (shells are not cut into parts): its rows are all of them.
-      const hsize_t t = sh.triangles.size(), v = sh.reference.size();
-      const Rows triangle_rows{t, 0, t}, vertex_rows{v, 0, v};
+    if (total[3] > 0) {
       std::vector<std::int64_t> triangles;
       for (const auto& c : sh.triangles) triangles.insert(triangles.end(), c.begin(), c.end());
       write_rows(group.get(), "shell_coordinates", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.reference.data(),
@@ -415,8 +414,8 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
       write_rows(group.get(), "shell_topology", H5T_NATIVE_INT64, H5T_STD_I64LE, triangles.data(), triangle_rows, 3);
       write_rows(group.get(), "shell_body", H5T_NATIVE_INT, H5T_STD_I32LE, sh.body.data(), triangle_rows, 0);
     }
-    s.mesh_triangles = static_cast<long long>(sh.triangles.size());
-    s.mesh_shell_vertices = static_cast<long long>(sh.reference.size());
+    s.mesh_triangles = total[3];
+    s.mesh_shell_vertices = total[2];
     s.mesh_revision = mesh.revision;
     s.mesh_order = order;
     s.mesh_nodes = total[0];
@@ -440,9 +439,7 @@ void FieldWriter::State::write_frame(const Mesh& mesh, const FieldFrame& frame) 
              frame.displacement.data(), node_rows, 3);
   write_rows(group.get(), "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, frame.velocity.data(),
              node_rows, 3);
-  if (!sh.triangles.empty()) {
-    const hsize_t v = sh.displacement.size(), t = sh.triangles.size();
-    const Rows vertex_rows{v, 0, v}, triangle_rows{t, 0, t};
+  if (total[3] > 0) {
     write_rows(group.get(), "shell_displacement", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.displacement.data(),
                vertex_rows, 3);
     write_rows(group.get(), "shell_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, sh.velocity.data(),

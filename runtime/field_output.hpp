@@ -75,10 +75,11 @@ struct FieldFrame {
   const ShellFrame* shells = nullptr;
 };
 
-/// The shells' mid-surface in one frame (on one rank only: shells are not cut
-/// into parts), s triangles and v control vertices, body after body.
+/// The shells' mid-surface in one frame: the rows this rank writes (all of
+/// them on one rank), s triangles and v control vertices, after the rows of
+/// the lower ranks; the whole is body after body.
 struct ShellFrame {
-  std::vector<std::array<Index, 3>> triangles;  ///< [s] control triangles, in rows of the shell vertices
+  std::vector<std::array<Index, 3>> triangles;  ///< [s] control triangles, in rows of all ranks' shell vertices
   std::vector<int> body;                         ///< [s] body index
   /// [v] the limit surface at the control vertices: reference point (m),
   /// displacement (m) and velocity (m/s)

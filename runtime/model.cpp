@@ -177,18 +177,13 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
   std::vector<std::vector<PhysicalGroup>> groups;
   RegionSelection selection;
   double mesh_seconds = 0;
-  if (ranks > 1 && scene.has_shells())
-    for (const BodySpec& b : scene.bodies)
-      if (b.shell)
-        throw InputError(scene.file + ": " + b.key + ".shell: shells run on one MPI rank (" + std::to_string(ranks) +
-                         " here; their parts and 2-ring ghost layer are not built yet); expected mpirun -np 1");
   if (!parts.empty()) {
     if (ranks == 1)
       throw InputError("--parts " + parts.string() + ": part files are for runs on several ranks; expected mpirun -np R "
                        "with the R of `shatter partition --ranks R`, or a run without --parts");
-    if (scene.fracture_enabled() && scene.contact)
-      throw InputError(scene.file + ": fracture with contact holds the whole model on every rank (docs/parallel.md "
-                                    "\"Limits\"); expected a run without --parts");
+    if (scene.has_shells() || (scene.fracture_enabled() && scene.contact))
+      throw InputError(scene.file + ": " + (scene.has_shells() ? "shells hold" : "fracture with contact holds") +
+                       " the whole model on every rank (docs/parallel.md \"Limits\"); expected a run without --parts");
     const auto t0 = std::chrono::steady_clock::now();
     read_part_file(m, parts, comm);
     mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -197,13 +192,15 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
     m.shells = add_shell_bodies(scene, m.mesh);
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
-  } else if (scene.fracture_enabled() && scene.contact) {
-    // Cracks in contact still need the whole model on every rank (docs/parallel.md "Limits").
-    on_root(comm, [&] {
-      m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds);
-      selection = select_regions(scene, m.mesh, groups);
-    });
+  } else if ((scene.fracture_enabled() && scene.contact) || scene.has_shells()) {
+    // Cracks in contact, and shells, still need the whole model on every
+    // rank (docs/parallel.md "Limits", "Shells on ranks"): every rank builds
+    // the shells (each one's Gmsh meshes the same mid-surfaces) after the
+    // solids' nodes.
+    on_root(comm, [&] { m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds); });
     broadcast_mesh(m.mesh, 0, comm);
+    m.shells = add_shell_bodies(scene, m.mesh);
+    on_root(comm, [&] { selection = select_regions(scene, m.mesh, groups); });
     broadcast_selection(selection, scene, comm);
     complete_model(m, selection);
   } else {

@@ -123,7 +123,8 @@ std::filesystem::path part_file(const std::filesystem::path& dir, int rank, int 
 std::vector<std::uintmax_t> write_part_files(const Model& whole, int ranks, const std::filesystem::path& dir) {
   const Scene& scene = whole.scene;
   if (scene.has_shells())
-    throw InputError(scene.file + ": shells run on one MPI rank; their parts are not built yet, so there is nothing to partition");
+    throw InputError(scene.file + ": shells hold the whole model on every rank (docs/parallel.md \"Shells on ranks\"); "
+                                  "expected a scene without shells, or a run that meshes at start-up");
   if (scene.fracture_enabled() && scene.contact)
     throw InputError(scene.file + ": fracture with contact holds the whole model on every rank (docs/parallel.md "
                                   "\"Limits\"); expected a scene without both, or a run that meshes at start-up");

@@ -102,6 +102,30 @@ ShellBody build_shell_body(const Scene& scene, int body, const std::string& wher
   return s;
 }
 
+ShellPatchNodes shell_patch_nodes(const std::vector<ShellBody>& shells) {
+  std::vector<std::vector<Index>> lists;
+  ShellPatchNodes out;
+  for (const ShellBody& s : shells)
+    for (const ShellPatchSet& set : s.sets)
+      for (const Index t : set.triangle) {
+        std::vector<Index>& l = lists.emplace_back();
+        for (int a = 0; a < set.size(); ++a)
+          s.mesh.scatter_entry(s.mesh.patch_of(t)[a], [&](Index v, double) { l.push_back(s.first_node + v); });
+        std::sort(l.begin(), l.end());
+        l.erase(std::unique(l.begin(), l.end()), l.end());
+        out.width = std::max(out.width, static_cast<int>(l.size()));
+      }
+  out.nodes.assign(lists.size() * out.width, -1);
+  for (std::size_t p = 0; p < lists.size(); ++p) std::copy(lists[p].begin(), lists[p].end(), out.nodes.begin() + p * out.width);
+  return out;
+}
+
+Index shell_vertices(const std::vector<ShellBody>& shells) {
+  Index n = 0;
+  for (const ShellBody& s : shells) n += s.mesh.num_vertices();
+  return n;
+}
+
 std::vector<std::pair<Index, double>> shell_corner_stencil(const ShellBody& s, Index t, int c) {
   constexpr double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
   const Index n = s.mesh.patch_size(t) - 6;

@@ -6,6 +6,7 @@
 // the valence N of the patch's irregular corner (N = 6: regular patches and
 // boundary patches completed by ghosts), with K = N + 6 control entries.
 #include <array>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -21,6 +22,11 @@ namespace shatter {
 /// Quadrature points per shell element (ShellQuadrature<3>: degree 2, the
 /// rule the kernels' accuracy figures were measured with).
 inline constexpr int kShellPoints = 3;
+/// Shell control vertices per granule (docs/parallel.md "Shells on ranks"):
+/// the unit of their ownership between MPI ranks and of their terms in
+/// global sums, kShellGranule vertices of all shell bodies consecutive along
+/// a Morton curve of their reference positions (runtime/decomposition.cpp).
+inline constexpr Index kShellGranule = 32;
 /// The valences of an extraordinary corner the runtime has element sets for.
 inline constexpr int kShellMinValence = 3, kShellMaxValence = 12;
 
@@ -113,6 +119,22 @@ void shell_limit_stencils(ShellBody& shell);
 /// (patch entry, weight) pairs; empty when that corner is the extraordinary
 /// one of the patch.
 std::vector<std::pair<Index, double>> shell_corner_stencil(const ShellBody& shell, Index t, int c);
+
+/// The model nodes each shell patch reads and adds forces to (its entries'
+/// vertices, ghosts' included), every patch of every body in force-slot
+/// order (body after body, set after set), `width` ids each, ascending,
+/// padded with -1.
+struct ShellPatchNodes {
+  int width = 0;
+  std::vector<Index> nodes;
+  Index patches() const { return width == 0 ? 0 : static_cast<Index>(nodes.size()) / width; }
+  std::span<const Index> of(Index p) const { return {nodes.data() + static_cast<std::size_t>(p) * width, static_cast<std::size_t>(width)}; }
+};
+ShellPatchNodes shell_patch_nodes(const std::vector<ShellBody>& shells);
+
+/// Control vertices of all shell bodies (they are the model's nodes from
+/// shells.front().first_node on, body after body).
+Index shell_vertices(const std::vector<ShellBody>& shells);
 
 /// About how many control triangles build_shell_body makes of a mid-surface:
 /// its area over that of an equilateral triangle of edge element_size.

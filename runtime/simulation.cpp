@@ -370,6 +370,7 @@ void Simulation::share_plans() {
   if (fracture_) fracture_->share();
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
+  if (shells_) shells_->restrict_to(dec_->touched_nodes(), [&](Index n) { return dec_->owns_node(n); });
 }
 
 void Simulation::grow_nodes(const std::vector<std::array<Index, 2>>& new_nodes) {

@@ -176,9 +176,11 @@ class Simulation {
     double check_cpu_max = 0, insert_cpu_max = 0;  ///< the largest rank's thread CPU time, s
     long owned_min = 0, owned_max = 0;  ///< cohesive elements a rank owns, fewest and most
   };
-  /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max.
+  /// `memory`: peak_memory_bytes_per_rank (rank order) and model_bytes_per_rank_max;
+  /// `shell`: shell elements owned per rank (fewest, most) and computed per rank (most).
   void write_summary(double wall_seconds, const DecompositionStats& stats, const ContactBalance& contact_balance,
-                     const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory);
+                     const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory,
+                     const std::array<long, 3>& shell);
   /// Bytes of the arrays this rank holds in the loop: the model's and the
   /// time loop's own (nodal state, stresses); the contact and fracture
   /// stages' are not counted.

@@ -29,8 +29,8 @@ void Simulation::check_step_collapse(long step, double time) {
   StepCollapse c;
   c.dt = stable_dt_;
   c.dt0 = stable_dt0_;
-  // A shell element set the step (shells run on one rank): no tetrahedron to name.
-  if (least.e == std::numeric_limits<int>::max() || last_shells_.stable_dt < least.dt) throw PhysicsError(step_collapse_diagnosis(model_, c, step, time));
+  // A shell element set the step: no tetrahedron to name.
+  if (least.e == std::numeric_limits<int>::max() || dec_->min(last_shells_.stable_dt) < least.dt) throw PhysicsError(step_collapse_diagnosis(model_, c, step, time));
   // Its owner has its current positions and its part of the mesh.
   throw PhysicsError(from_owner(least.e, [&](Index e) {
     c.element = e;

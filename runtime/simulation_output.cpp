@@ -56,37 +56,60 @@ void Simulation::write_outputs(bool fields) {
 
 namespace {
 
-/// The shells' mid-surface at positions x and velocities v (one rank): the
-/// control triangles, their corners on the limit surface (ShellBody::limit_*)
-/// and the triangles' resultants, body after body.
-ShellFrame shell_frame(const Model& model, std::span<const Vec3> x, std::span<const Vec3> v,
-                       const ShellForces* forces) {
-  ShellFrame out;
-  for (const ShellBody& sb : model.shells) {
-    const Index row0 = static_cast<Index>(out.reference.size());
-    for (const auto& t : sb.mesh.triangles) {
-      out.triangles.push_back({row0 + t[0], row0 + t[1], row0 + t[2]});
-      out.body.push_back(sb.body);
-    }
+/// The shells' mid-surface at positions x and velocities v, the rows this
+/// rank writes: each rank packs its owned control vertices (the limit surface
+/// there, ShellBody::limit_*, whose stencil reads vertices of a patch it
+/// computes) and the triangles whose patches it owns (corners in whole
+/// shell-vertex rows, body, resultants); the rows move to contiguous blocks
+/// of the whole order (row_blocks.hpp), as the solids' do.
+ShellFrame shell_frame(const Model& model, const Decomposition& dec, std::span<const Vec3> x,
+                       std::span<const Vec3> v, const ShellForces& forces) {
+  constexpr int kVertexWidth = 9, kTriangleWidth = 16;  // X, u, v; corners, body, n (6), m (6)
+  constexpr int row[6] = {0, 1, 2, 1, 0, 0}, col[6] = {0, 1, 2, 2, 2, 1};  // Voigt xx yy zz yz xz xy
+  const std::vector<ShellResultants> resultants = forces.resultants(x);
+  std::vector<Index> vertex_ids, triangle_ids;
+  std::vector<double> vertex_rows, triangle_rows;
+  Index row0 = 0, triangle0 = 0;
+  for (std::size_t b = 0; b < model.shells.size(); ++b) {
+    const ShellBody& sb = model.shells[b];
     for (Index p = 0; p < sb.mesh.num_vertices(); ++p) {
+      if (!dec.owns_node(sb.first_node + p)) continue;
       Vec3 du = Vec3::Zero(), dv = Vec3::Zero();
       for (Index k = sb.limit_offsets[p]; k < sb.limit_offsets[p + 1]; ++k) {
         const Index i = sb.first_node + sb.limit_vertex[k];
         du += sb.limit_weight[k] * (x[i] - model.mesh.reference[i]);
         dv += sb.limit_weight[k] * v[i];
       }
-      out.reference.push_back(sb.limit_reference[p]);
-      out.displacement.push_back(du);
-      out.velocity.push_back(dv);
+      vertex_ids.push_back(row0 + p);
+      for (const Vec3& w : {sb.limit_reference[p], du, dv}) vertex_rows.insert(vertex_rows.end(), w.data(), w.data() + 3);
     }
+    for (Index t = 0; t < sb.mesh.num_triangles(); ++t) {
+      if (!forces.owns_triangle(b, t)) continue;
+      triangle_ids.push_back(triangle0 + t);
+      for (const Index c : sb.mesh.triangles[t]) triangle_rows.push_back(static_cast<double>(row0 + c));
+      triangle_rows.push_back(sb.body);
+      const ShellResultants& r = resultants[triangle0 + t];
+      for (int c = 0; c < 6; ++c) triangle_rows.push_back(r.n(row[c], col[c]));
+      for (int c = 0; c < 6; ++c) triangle_rows.push_back(r.m(row[c], col[c]));
+    }
+    row0 += sb.mesh.num_vertices();
+    triangle0 += sb.mesh.num_triangles();
   }
-  if (forces)
-    for (const ShellResultants& r : forces->resultants(x))
-      for (int c = 0; c < 6; ++c) {
-        constexpr int row[6] = {0, 1, 2, 1, 0, 0}, col[6] = {0, 1, 2, 2, 2, 1};  // Voigt xx yy zz yz xz xy
-        out.membrane_force.push_back(r.n(row[c], col[c]));
-        out.bending_moment.push_back(r.m(row[c], col[c]));
-      }
+  const MPI_Comm comm = dec.distributed() ? dec.comm() : MPI_COMM_SELF;
+  const std::vector<double> vb = to_row_blocks(vertex_ids, vertex_rows, kVertexWidth, row0, comm);
+  const std::vector<double> tb = to_row_blocks(triangle_ids, triangle_rows, kTriangleWidth, triangle0, comm);
+  ShellFrame out;
+  for (std::size_t r = 0; r < vb.size(); r += kVertexWidth) {
+    out.reference.emplace_back(vb[r], vb[r + 1], vb[r + 2]);
+    out.displacement.emplace_back(vb[r + 3], vb[r + 4], vb[r + 5]);
+    out.velocity.emplace_back(vb[r + 6], vb[r + 7], vb[r + 8]);
+  }
+  for (std::size_t r = 0; r < tb.size(); r += kTriangleWidth) {
+    out.triangles.push_back({static_cast<Index>(tb[r]), static_cast<Index>(tb[r + 1]), static_cast<Index>(tb[r + 2])});
+    out.body.push_back(static_cast<int>(tb[r + 3]));
+    out.membrane_force.insert(out.membrane_force.end(), tb.begin() + r + 4, tb.begin() + r + 10);
+    out.bending_moment.insert(out.bending_moment.end(), tb.begin() + r + 10, tb.begin() + r + 16);
+  }
   return out;
 }
 
@@ -168,7 +191,16 @@ void Simulation::write_fields(std::span<const Index> elem_fragment) {
   f.body = body;
   f.fragment = fragment;
   f.damage = block_damage;
-  const ShellFrame shells = shell_frame(model_, x_, v_, shells_.get());
+  // A shell vertex's limit velocity reads its patches' vertices: the
+  // ghost-only ones get their owners' velocities (the step sends positions only).
+  std::vector<Vec3> shell_v;
+  if (shells_ && dec_->distributed()) {
+    shell_v = v_;
+    dec_->begin_ghost_update(shell_v);
+    dec_->end_ghost_update(shell_v);
+  }
+  const ShellFrame shells =
+      shells_ ? shell_frame(model_, *dec_, x_, shell_v.empty() ? v_ : shell_v, *shells_) : ShellFrame{};
   if (shells_) f.shells = &shells;
   fields_->write(block, f);
 }
@@ -203,7 +235,8 @@ long Simulation::loop_bytes() const {
 }
 
 void Simulation::write_summary(double wall, const DecompositionStats& stats, const ContactBalance& contact_balance,
-                               const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory) {
+                               const FractureSummary& fracture, const std::pair<std::vector<long>, long>& memory,
+                               const std::array<long, 3>& shell) {
   const Ledger& l = ledger_;
   JsonObject j;
   j.add("name", model_.scene.name);
@@ -230,6 +263,15 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("local_elements_max", stats.local_max);
   j.add("ghost_bytes_per_step_max", stats.ghost_bytes_max);
   j.add("ghost_messages_per_step_max", stats.ghost_messages_max);
+  if (shells_) {
+    // Shell patches (docs/parallel.md "Shells on ranks"): the whole count, owned and computed per rank.
+    long triangles = 0;
+    for (const ShellBody& s : model_.shells) triangles += s.mesh.num_triangles();
+    j.add("shell_elements", triangles);
+    j.add("shell_owned_elements_min", shell[0]);
+    j.add("shell_owned_elements_max", shell[1]);
+    j.add("shell_local_elements_max", shell[2]);
+  }
   // No contact surface state goes to every rank any more (the patches, docs/parallel.md).
   j.add("shared_surface_bytes_per_step", 0L);
   // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).

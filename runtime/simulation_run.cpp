@@ -1,6 +1,7 @@
 // Simulation::run: the time loop with its outputs, progress, checkpoints
 // (periodic, on SIGINT/SIGTERM, of the last good state when a step fails)
 // and the failure protocol across ranks (runtime/failure.hpp).
+#include <array>
 #include <chrono>
 #include <optional>
 
@@ -117,7 +118,13 @@ long Simulation::run() {
     const DecompositionStats stats = dec_->stats();
     const ContactBalance pairs = contact_ ? contact_->balance() : ContactBalance{};
     const std::pair<std::vector<long>, long> memory{dec_->gather(peak_memory_bytes()), dec_->max(loop_bytes())};
-    if (root) write_summary(wall, stats, pairs, fracture, memory);
+    // Shell elements per rank: owned (smallest, largest) and computed (owned + ghost, largest).
+    std::array<long, 3> shell{};
+    if (shells_) {
+      const long owned = shells_->owned_elements();
+      shell = {-dec_->max(-owned), dec_->max(owned), dec_->max(static_cast<long>(shells_->elements()))};
+    }
+    if (root) write_summary(wall, stats, pairs, fracture, memory, shell);
   }
   return step_;
 }

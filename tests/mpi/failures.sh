@@ -14,7 +14,8 @@
 #   - bad input on every rank: exit 2, one error line;
 #   - a mesh too small for the ranks (fewer granules of 256 elements than
 #     ranks): exit 2, one error line that says how many ranks it can take;
-#   - a shell body (shells run on one rank): exit 2, one error line.
+#   - a shell too small for the ranks (fewer granules of 32 control vertices
+#     than ranks): exit 2, one error line that says how many ranks it can take.
 # A hang is caught by `timeout` (and ctest's TIMEOUT), 100 s a run times the
 # sanitized build's SHATTER_TEST_TIMEOUT_SCALE (tests/CMakeLists.txt).
 # usage: failures.sh SHATTER FAIL_ALONE MPIEXEC WORKDIR
@@ -80,7 +81,7 @@ timeout -k 10 "$limit" "$shatter" run "$work/box.yaml" --threads 1 --quiet --out
 run bad_input 2 "time.end: expected a positive number, got 'soon'" "${mpi[@]}" --out "$work/bad" --set time.end=soon
 run too_many_ranks 2 "cannot be shared by 2 MPI ranks (use at most 1)" "${mpi[@]}" --out "$work/small" \
   --set bodies[0].mesh.element_size=0.005
-run shells_one_rank 2 "bodies[0].shell: shells run on one MPI rank (2 here" "${mpi[@]}" --out "$work/shell" \
-  --set "bodies[0].shell={thickness: 0.001}" --set "bodies[0].mesh={shape: sphere, radius: 0.1, element_size: 0.05}" \
+run too_many_ranks_shell 2 "granule of 32; they cannot be shared by 2 MPI ranks (use at most 1)" "${mpi[@]}" --out "$work/shell" \
+  --set "bodies[0].shell={thickness: 0.001}" --set "bodies[0].mesh={shape: sphere, radius: 0.1, element_size: 0.1}" \
   --set "bodies[0].angular_velocity=[0, 0, 0]"
 exit $fail

@@ -15,8 +15,11 @@
 #   local_fracture: as fracture, but the cracks stay on one rank: at 3 ranks a
 #             rank owns no cohesive element and another owns them all;
 #   volume:   (no contact, no fracture) at 3 ranks each rank held only its
-#             part of the model: model_bytes_per_rank_max below 0.6x that of 1 rank.
-# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture|local_fracture|volume [--set key=value ...]
+#             part of the model: model_bytes_per_rank_max below 0.6x that of 1 rank;
+#   shell:    (shells without contact) the scene has shell elements.
+# With shell bodies (any kind), at 3 ranks each rank computed fewer than all
+# shell elements, each owned some, and the ghost update sent bytes.
+# usage: same_history.sh SHATTER MPIEXEC SCENE WORKDIR contact|fracture|local_fracture|volume|shell [--set key=value ...]
 set -euo pipefail
 shatter=$1 mpiexec=$2 scene=$3 work=$4 kind=$5
 shift 5
@@ -35,7 +38,7 @@ run 4 1
 bytes() { grep -o '"model_bytes_per_rank_max": [0-9]*' "$work/$1/summary.json" | grep -o '[0-9]*$'; }
 status=0
 for d in r2t1 r1t2 r3t1 r4t1; do
-  for f in history.csv bodies.csv $([ "$kind" != contact ] && [ "$kind" != volume ] && echo fragments.csv); do
+  for f in history.csv bodies.csv $([ "$kind" != contact ] && [ "$kind" != volume ] && [ "$kind" != shell ] && echo fragments.csv); do
     if ! cmp -s "$work/r1t1/$f" "$work/$d/$f"; then
       echo "FAIL: $d/$f differs from r1t1/$f:"
       diff "$work/r1t1/$f" "$work/$d/$f" | head -4
@@ -66,6 +69,9 @@ if [ "$kind" = contact ]; then
   passed=$(grep -o '"contact_states_passed": [0-9]*' "$work/r3t1/summary.json" | awk '{print $2}')
   awk -v m="${passed:-0}" 'BEGIN { exit !(m > 0) }' || { echo "FAIL: at 3 ranks no pair waited for one on another rank"; status=1; }
   what="$what, $passed states passed between ranks"
+elif [ "$kind" = shell ]; then
+  n=$(grep -o '"shell_elements": [0-9]*' "$work/r1t1/summary.json" | grep -o '[0-9]*$')
+  what="$n shell elements"
 elif [ "$kind" = volume ]; then
   one=$(bytes r1t1) three=$(bytes r3t1)
   awk -v a="$three" -v b="$one" 'BEGIN { exit !(a < 0.6 * b) }' && n=1 || n=0
@@ -88,6 +94,16 @@ else
       { echo "FAIL: model bytes per rank $three at 3 ranks, $one at 1: the ranks do not hold parts"; status=1; }
     what="$what, model bytes per rank $three at 3 ranks, $one at 1"
   fi
+fi
+if grep -q '^ *shell:' "$scene"; then
+  # Shells on ranks (docs/parallel.md "Shells on ranks"): at 3 ranks each rank
+  # computes only its patches and their ghost layer, whose positions travel.
+  key3() { grep -o "\"$1\": [0-9]*" "$work/r3t1/summary.json" | grep -o '[0-9]*$'; }
+  total=$(key3 shell_elements) local=$(key3 shell_local_elements_max) owned=$(key3 shell_owned_elements_min)
+  ghost=$(key3 ghost_bytes_per_step_max)
+  [ "${local:-0}" -lt "${total:-0}" ] && [ "${owned:-0}" -gt 0 ] && [ "${ghost:-0}" -gt 0 ] ||
+    { echo "FAIL: at 3 ranks a rank computes $local of $total shell elements, owns at least $owned, sends $ghost ghost bytes per step: the shells are not shared"; status=1; }
+  what="$what, at 3 ranks at most $local of $total shell elements computed per rank, at least $owned owned, $ghost ghost bytes per step"
 fi
 [ "${n:-0}" -gt 0 ] || { echo "FAIL: $what: the comparison does not cover $kind"; status=1; }
 [ $status -eq 0 ] && echo "same outputs at 1x1, 2x1, 1x2, 3x1, 4x1 ($what)"
