@@ -55,11 +55,13 @@ struct Model {
 
   /// The shell bodies, in body order (docs/shells.md "The runtime"): their
   /// control vertices are the model's last nodes (ShellBody::first_node), in
-  /// no element of `mesh`. Only on a whole model (shells run on one rank).
+  /// no element of `mesh`. Only on a whole model (a scene with shells holds the
+  /// whole model on every rank: docs/parallel.md "Shells on ranks").
   std::vector<ShellBody> shells;
 
   /// Wall seconds the start-up rank spent meshing (Gmsh) or reading the bodies
   /// and ordering their elements (summary.json mesh_time); 0 on the other ranks.
+  /// With part files (build_model's `parts`), each rank's seconds reading its part.
   double mesh_seconds = 0;
 
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
