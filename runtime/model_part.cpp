@@ -165,12 +165,8 @@ void cut_parts(const Model& whole, int ranks, const std::function<void(int, Mode
   const Partition p = partition(whole, ranks);
   std::vector<std::vector<Index>> held = held_elements(whole.mesh, p.touch, ranks, whole.scene.fracture_enabled());
   std::vector<Index> local(whole.mesh.num_nodes(), -1);
-  for (int r = 0; r < ranks; ++r) {
-    Model part = cut(whole, p, std::move(held[r]), local);
-    // (cut() grows its arrays one push at a time; a received or read part's are exact.)
-    for_each_array(part, [](auto& v) { v.shrink_to_fit(); });
-    each(r, std::move(part));
-  }
+  // Rank 0's part last: the start-up rank keeps its own part only once the others are gone.
+  for (int k = 1; k <= ranks; ++k) each(k % ranks, cut(whole, p, std::move(held[k % ranks]), local));
 }
 
 void put_part(const Model& m, const std::function<void(const void*, std::uint64_t)>& put) {
@@ -259,6 +255,8 @@ void distribute_parts(Model& model, MPI_Comm comm) {
     if (r == 0) return void(mine = std::move(part));
     put_part(part, [&](const void* data, std::uint64_t bytes) { send_bytes(data, bytes, r, comm); });
   });
+  // (cut() grows its arrays one push at a time; the received ones are exact.)
+  for_each_array(mine, [](auto& v) { v.shrink_to_fit(); });
   mine.scene = std::move(model.scene);
   mine.materials = std::move(model.materials);
   model = std::move(mine);

@@ -25,8 +25,8 @@ class Decomposition;
 void distribute_parts(Model& model, MPI_Comm comm);
 
 /// Cuts `whole` into its parts for `ranks` ranks (the partition distribute_parts
-/// uses) and hands each, in rank order, to each(rank, part) (without scene and
-/// materials). Holds the whole model and one part at a time.
+/// uses) and hands each to each(rank, part) (without scene and materials), rank
+/// 0's last. Holds the whole model and one part at a time.
 void cut_parts(const Model& whole, int ranks, const std::function<void(int, Model&&)>& each);
 
 /// A part's arrays as bytes, in a fixed order, through put(data, bytes).

@@ -134,7 +134,7 @@ std::vector<std::uintmax_t> write_part_files(const Model& whole, int ranks, cons
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir.string() + ": cannot make the folder: " + ec.message());
   const std::string physics = physics_keys(scene);
-  std::vector<std::uintmax_t> sizes;
+  std::vector<std::uintmax_t> sizes(ranks, 0);
   cut_parts(whole, ranks, [&](int r, Model&& part) {
     const std::filesystem::path path = part_file(dir, r, ranks), tmp = path.string() + ".tmp";
     HashedWriter w(tmp);
@@ -151,7 +151,7 @@ std::vector<std::uintmax_t> write_part_files(const Model& whole, int ranks, cons
     }
     std::filesystem::rename(tmp, path, ec);
     if (ec) throw Error(tmp.string() + ": cannot rename it to " + path.string() + ": " + ec.message());
-    sizes.push_back(std::filesystem::file_size(path));
+    sizes[r] = std::filesystem::file_size(path);
   });
   return sizes;
 }

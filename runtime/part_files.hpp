@@ -30,7 +30,7 @@ std::filesystem::path part_file(const std::filesystem::path& dir, int rank, int 
 
 /// Cuts `whole` (a model built on one rank) into its parts for `ranks` ranks and
 /// writes each into part_file(dir, r, ranks) (through a temporary file, renamed
-/// when complete). Returns each part file's size in bytes. Throws InputError
+/// when complete). Returns each part file's size in bytes, by rank. Throws InputError
 /// when the scene cannot run on parts (shells, or fracture with contact: these
 /// hold the whole model on every rank) or cannot take `ranks` ranks, and Error
 /// when a file cannot be written.
