@@ -167,6 +167,10 @@ void complete_model(Model& m, const RegionSelection& selection);
 
 }  // namespace
 
+bool whole_model_on_every_rank(const Scene& scene) {
+  return (scene.fracture_enabled() && scene.contact) || scene.has_shells();
+}
+
 Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const std::filesystem::path& parts) {
   Model m;
   m.scene = scene;
@@ -181,7 +185,7 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
     if (ranks == 1)
       throw InputError("--parts " + parts.string() + ": part files are for runs on several ranks; expected mpirun -np R "
                        "with the R of `shatter partition --ranks R`, or a run without --parts");
-    if (scene.has_shells() || (scene.fracture_enabled() && scene.contact))
+    if (whole_model_on_every_rank(scene))
       throw InputError(scene.file + ": " + (scene.has_shells() ? "shells hold" : "fracture with contact holds") +
                        " the whole model on every rank (docs/parallel.md \"Limits\"); expected a run without --parts");
     const auto t0 = std::chrono::steady_clock::now();
@@ -192,7 +196,7 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
     m.shells = add_shell_bodies(scene, m.mesh);
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
-  } else if ((scene.fracture_enabled() && scene.contact) || scene.has_shells()) {
+  } else if (whole_model_on_every_rank(scene)) {
     // Cracks in contact, and shells, still need the whole model on every
     // rank (docs/parallel.md "Limits", "Shells on ranks"): every rank builds
     // the shells (each one's Gmsh meshes the same mid-surfaces) after the

@@ -135,6 +135,11 @@ void append_node_row(To& to, const From& from, Index n) {
              node_arrays(to));
 }
 
+/// Whether every rank of a run on several holds the whole model of `scene`
+/// rather than its part: cracks in contact, and shells (docs/parallel.md
+/// "Limits", "Shells on ranks").
+bool whole_model_on_every_rank(const Scene& scene);
+
 /// Mesh every body, check the meshes, and compute every constant of the model.
 /// On several ranks of `comm` (collective) rank 0 meshes and computes the
 /// whole model. A scene without both fracture and contact is then cut: rank 0
