@@ -40,6 +40,15 @@ std::uint64_t morton_code(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return code;
 }
 
+std::pair<Vec3, Vec3> bounding_cube(std::span<const Vec3> points) {
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return {lo, lo + Vec3::Constant((hi - lo).maxCoeff())};
+}
+
 MeshPermutation reorder_for_locality(Mesh& mesh, GlobalIdPolicy gids) {
   const Index n = mesh.num_nodes(), ne = mesh.num_elements();
   const int k = mesh.nodes_per_element();
@@ -49,29 +58,16 @@ MeshPermutation reorder_for_locality(Mesh& mesh, GlobalIdPolicy gids) {
     std::iota(perm.node_new_of_old.begin(), perm.node_new_of_old.end(), 0);
     return perm;
   }
-  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
-  for (const Vec3& X : mesh.reference) {
-    lo = lo.cwiseMin(X);
-    hi = hi.cwiseMax(X);
-  }
-  // The curve in a cube around the mesh, one scale for every axis: its halves
-  // then split the longest side first, and a run of consecutive elements of an
-  // elongated body (a bar, a plate) is a compact piece of it. (A box of the
-  // mesh's own proportions split a bar's thickness first: a granule of a
-  // 12:1 bar spanned half its length, and at 2 ranks a part's two ghost
-  // layers held all but 2 of its 4318 elements.)
-  hi = lo + Vec3::Constant((hi - lo).maxCoeff());
-  // Element order: Morton code of the corner centroid, stable on ties.
-  std::vector<std::uint64_t> code(ne);
-  for (Index e = 0; e < ne; ++e) {
-    const Index* c = mesh.element(e);
-    const Vec3 centroid = 0.25 * (mesh.reference[c[0]] + mesh.reference[c[1]] + mesh.reference[c[2]] +
-                                  mesh.reference[c[3]]);
-    code[e] = morton_code(centroid, lo, hi);
-  }
-  std::vector<Index> old_of_new(ne);
-  std::iota(old_of_new.begin(), old_of_new.end(), 0);
-  std::stable_sort(old_of_new.begin(), old_of_new.end(), [&](Index a, Index b) { return code[a] < code[b]; });
+  // Element order: Morton code of the corner centroid in the mesh's cube, stable on ties.
+  const auto [lo, hi] = bounding_cube(mesh.reference);
+  const std::vector<Index> old_of_new = morton_order(
+      ne,
+      [&](Index e) {
+        const Index* c = mesh.element(e);
+        return Vec3(0.25 * (mesh.reference[c[0]] + mesh.reference[c[1]] + mesh.reference[c[2]] +
+                            mesh.reference[c[3]]));
+      },
+      lo, hi);
   perm.elem_new_of_old.resize(ne);
   for (Index i = 0; i < ne; ++i) perm.elem_new_of_old[old_of_new[i]] = i;
 

@@ -16,18 +16,14 @@
 namespace shatter {
 namespace {
 
-/// The position of each point along the Morton curve of the cube of their
-/// largest extent, from their lower corner (ties in index order).
+/// The position of each point along the Morton curve of their bounding cube
+/// (ties in index order).
 std::vector<Index> morton_positions(std::span<const Vec3> points) {
-  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
-  for (const Vec3& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const double extent = (hi - lo).maxCoeff();
-  std::vector<std::pair<std::uint64_t, Index>> code(points.size());
-  for (size_t i = 0; i < points.size(); ++i)
-    code[i] = {morton_code(points[i], lo, lo + Vec3::Constant(extent)), static_cast<Index>(i)};
-  std::sort(code.begin(), code.end());
-  std::vector<Index> position(points.size());
-  for (size_t k = 0; k < code.size(); ++k) position[code[k].second] = static_cast<Index>(k);
+  const auto [lo, hi] = bounding_cube(points);
+  const auto n = static_cast<Index>(points.size());
+  const std::vector<Index> order = morton_order(n, [&](Index i) { return points[i]; }, lo, hi);
+  std::vector<Index> position(n);
+  for (Index k = 0; k < n; ++k) position[order[k]] = k;
   return position;
 }
 
