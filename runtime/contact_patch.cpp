@@ -99,10 +99,10 @@ bool ContactPatch::owns(Index q) const {
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-                         std::span<const double> thickness) {
+                         std::span<const double> node_reach) {
   const int ranks = dec_.size(), me = dec_.rank();
-  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin, thickness);
-  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, thickness);
+  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin, node_reach);
+  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, node_reach);
   Box mine = empty_box();
   for (const auto* list : {&own.triangles, &own.edges})
     for (const Box& b : *list) {

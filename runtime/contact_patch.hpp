@@ -67,9 +67,9 @@ class ContactPatch {
   /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
   /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
   /// reach here; their nodes are PatchPlan::Patch. Collective.
-  /// `thickness`: the nodes' reach (inflated_boxes), empty without shells.
+  /// `node_reach`: per node, its reach (inflated_boxes), empty without shells.
   void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-             std::span<const double> thickness = {});
+             std::span<const double> node_reach = {});
   /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates)
   /// and of the triangles around them, whose normals orient the pairs. Collective.
   void activate(std::span<const ContactPair> pairs);
