@@ -13,6 +13,7 @@
 #include "runtime/field_output.hpp"
 #include "runtime/report.hpp"
 #include "runtime/simulation.hpp"
+#include "runtime/timed.hpp"
 
 namespace shatter {
 
@@ -94,7 +95,7 @@ long Simulation::run() {
                                          now - last_checkpoint >= std::chrono::duration<double>(every->every_seconds)));
     if (checkpoints && (due || stop) && !last) {
       save_state(good);
-      save_checkpoint(checkpoint, good);
+      timed(checkpoint_seconds_, [&] { save_checkpoint(checkpoint, good); });
       last_checkpoint = now;
     }
     if (stop) {
