@@ -19,9 +19,9 @@ for r in $ranks; do
   out=$work/r$r
   "${mpi[@]}" -n "$r" "$shatter" run "$here/block_step.yaml" --out "$out" --threads 1 --quiet \
     --set "bodies[0].mesh.element_size=$h" --set "checkpoint.every_steps=$((steps / 2))" \
-    --set "time.end=$(python3 -c "print($steps * 1.3e-7 * $h / 0.0027)")"
-  t=$(python3 -c "import h5py; print(h5py.File('$out/checkpoint.h5', 'r').attrs['time'])")
-  end=$(python3 -c "print($t * 1.0000001 + 1e-10)")
+    --set "time.end=$(/usr/bin/python3 -c "print($steps * 1.3e-7 * $h / 0.0027)")"
+  t=$(/usr/bin/python3 -c "import h5py; print(h5py.File('$out/checkpoint.h5', 'r').attrs['time'])")
+  end=$(/usr/bin/python3 -c "print($t * 1.0000001 + 1e-10)")
   t0=$(date +%s.%N)
   "${mpi[@]}" -n "$r" "$shatter" run "$here/block_step.yaml" --restart "$out/checkpoint.h5" --threads 1 --quiet \
     --set "bodies[0].mesh.element_size=$h" --set "time.end=$end" --out "$out.restart" 2>/dev/null || true
@@ -30,6 +30,6 @@ for r in $ranks; do
   grep -o '"peak_memory_bytes_per_rank": \[[^]]*\]' "$out/summary.json"
   echo "  checkpoint_time $(key checkpoint_time "$out/summary.json") s, wall_time $(key wall_time "$out/summary.json") s"
   grep -o '"peak_memory_bytes_per_rank": \[[^]]*\]' "$out.restart/summary.json" 2>/dev/null | sed 's/^/  restart: /' || true
-  echo "  restart wall $(python3 -c "print(round($t1 - $t0, 2))") s"
+  echo "  restart wall $(/usr/bin/python3 -c "print(round($t1 - $t0, 2))") s"
 done
 rm -rf "$work"

@@ -50,7 +50,7 @@ long Simulation::run() {
   if (!restored_) write_outputs(field_every > 0);
   // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
   // last good state when a step fails. On
-  // several ranks, rank 0 writes the owners' values (save_checkpoint).
+  // several ranks, every rank writes its own rows (save_checkpoint).
   const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
   const bool checkpoints = !opt_.out_dir.empty();
   SimulationState good;  // the state before the current step
