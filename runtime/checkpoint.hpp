@@ -10,7 +10,10 @@
 // carries the HDF5 metadata checksum):
 //   /  attributes
 //       format        string "shatter-checkpoint"
-//       version       int64 6 (5: without free rigid bodies, refused with them;
+//       version       int64 7 (6: each dataset's fnv1a64 the FNV-1a of its
+//                     bytes in order, still read, by a part block by block
+//                     over the whole dataset;
+//                     5: without free rigid bodies, refused with them;
 //                     4: /fracture's facets by index, refused with
 //                     fracture; 3: without the ledger's contact_work; 2: without
 //                     physics, scene_fingerprint and history_every, read without
@@ -48,8 +51,16 @@
 //       body, in body order (RigidBodyState): (mass kg, 0, 0), principal moments kg m^2,
 //       centre m, velocity m/s, the orientation's three columns, angular momentum
 //       kg m^2/s, force N, torque N m (a prescribed body: moments 1 and L = omega)
-//       each dataset has attribute fnv1a64 (uint64): FNV-1a hash of its bytes,
-//       so a flipped byte in the raw data is found too
+//       each dataset has attribute fnv1a64 (uint64): the sum (mod 2^64) over
+//       its rows r (0, 1, ...) of FNV-1a of the row's bytes (little-endian, as
+//       stored) seeded with FNV-1a of r as a uint64, so a flipped byte in the raw
+//       data, or a row moved, is found too; each rank hashes the rows it writes
+//       or owns at a restart, and the sums are added over the ranks
+//
+// Written collectively (MPI-IO) by every rank of a run, each its own rows
+// (a node's: the smallest rank touching it; an element's and a cohesive
+// element's: their owners'), moved to contiguous blocks (row_blocks.hpp) in
+// the whole model's order: the file is the same for any number of ranks.
 //   /ledger  attributes: the Ledger fields by their history.csv names
 //       (float64 kinetic ... external_work, px py pz, Lx Ly Lz; int64 contacts,
 //       cohesive_elements, fragments, contact_capped_steps)
@@ -68,8 +79,11 @@
 //
 // Contact needs nothing more: its surface is rebuilt from the mesh and its
 // pair lists are filtered to a fresh search's every step.
+#include <mpi.h>
+
 #include <cstdint>
 #include <filesystem>
+#include <vector>
 #include <string>
 
 #include "runtime/model.hpp"
@@ -85,14 +99,29 @@ std::uint64_t model_fingerprint(const Model& model);
 /// model_fingerprint() of the whole model (a part carries it, Model::Part).
 std::uint64_t whole_fingerprint(const Model& model);
 
+/// The rows of a checkpoint that one rank writes, as local indices ascending
+/// in the whole model's order: `nodes` of the state's and the fracture
+/// state's node arrays, `elements` of the fracture state's conn, `cohesive`
+/// of its cohesive elements (and their facets). Over the ranks of `comm`,
+/// every row of the whole model once (its owner's).
+struct CheckpointRows {
+  MPI_Comm comm = MPI_COMM_SELF;
+  std::vector<Index> nodes, elements, cohesive;
+};
+/// Every row of `state`, a whole model's (one rank).
+CheckpointRows all_rows(const Model& model, const SimulationState& state);
+
 /// Writes `state` (from Simulation::save_state) of a run of `model` to `path` atomically: `path`.tmp is
 /// written, flushed and fsync'ed, then renamed over `path` (and the folder
 /// fsync'ed), so `path` is always either the previous checkpoint or this one.
 /// `failure`: empty, or the message of the error the step after `state` threw.
-/// Throws shatter::Error naming the path when HDF5 or the file system fails;
-/// `path` is then untouched.
-void write_checkpoint(const std::filesystem::path& path, const Model& model,
-                      const SimulationState& state, const std::string& failure = "");
+/// `rows`: null for the whole state of one rank; else this rank's rows, and
+/// every rank of rows->comm calls this together (the file is written
+/// collectively through MPI-IO, each rank its own rows; no rank holds a
+/// whole-model array). Throws shatter::Error naming the path when HDF5 or the
+/// file system fails on any rank, the same on every rank; `path` is then untouched.
+void write_checkpoint(const std::filesystem::path& path, const Model& model, const SimulationState& state,
+                      const std::string& failure = "", const CheckpointRows* rows = nullptr);
 
 /// Reads a checkpoint of `model` written by write_checkpoint. Throws
 /// InputError naming the path and the reason when the file is missing,
@@ -103,14 +132,16 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
 /// boundary conditions, contact, gravity, ...) differs from the checkpoint's,
 /// naming the first key that differs. `run`, when given, receives what the
 /// checkpoint says of the run that wrote it. A part of the model
-/// (Model::is_part) gets its own nodes' rows and reactions, read block by
-/// block with every dataset's hash still checked: the whole state is never
+/// (Model::is_part) gets its own nodes' rows and reactions and reads only
+/// those (version 7), every rank of `comm` together: each hashes the rows it
+/// is the owner of, the sums are added over the ranks and checked, and any
+/// rank's refusal is every rank's (the same message). The whole state is never
 /// in a rank's memory.
 struct CheckpointRun {
   long history_every = 0;  ///< output.history_every of that run; 0: not recorded (version 2)
 };
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model,
-                                CheckpointRun* run = nullptr);
+                                CheckpointRun* run = nullptr, MPI_Comm comm = MPI_COMM_WORLD);
 
 /// Removes the rows of a CSV file whose first column (step) is above `step`,
 /// so that a restarted run appends its rows to it without duplicating any.

@@ -10,7 +10,6 @@
 #include "mesh/reorder.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
-#include "runtime/row_blocks.hpp"
 #include "runtime/shell_model.hpp"
 
 namespace shatter {
@@ -278,35 +277,6 @@ DecompositionStats Decomposition::stats() const {
                static_cast<long>(ghost_bytes()), halo_ ? halo_->update_messages() : 0};
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, v, 5, MPI_LONG, MPI_MAX, comm_);
   return {-v[0], v[1], v[2], v[3], v[4]};
-}
-
-std::vector<std::vector<Vec3>> Decomposition::gather_to_root(std::span<const std::span<const Vec3>> arrays) const {
-  const size_t m = arrays.size();
-  if (size_ == 1) {
-    std::vector<std::vector<Vec3>> whole;
-    for (const auto& a : arrays) whole.emplace_back(a.begin(), a.end());
-    return whole;
-  }
-  // Each node from its owner, as rows of the whole model's node order.
-  std::vector<Index> rows;
-  std::vector<double> values;
-  for (Index n : touched_nodes_) {
-    if (node_owner(n) != rank_) continue;
-    rows.push_back(model_.whole_node(n));
-    for (size_t a = 0; a < m; ++a) values.insert(values.end(), arrays[a][n].data(), arrays[a][n].data() + 3);
-  }
-  // The local ids ascend with the whole ids, so the rows do too.
-  const std::vector<double> all =
-      to_root(rows, values, static_cast<int>(3 * m), model_.whole_nodes(), comm_);
-  std::vector<std::vector<Vec3>> whole(m);
-  if (rank_ != 0) return whole;
-  const size_t nn = model_.whole_nodes();
-  for (size_t a = 0; a < m; ++a) {
-    whole[a].resize(nn);
-    for (size_t i = 0; i < nn; ++i)
-      for (int c = 0; c < 3; ++c) whole[a][i][c] = all[(i * m + a) * 3 + c];
-  }
-  return whole;
 }
 
 void Decomposition::sum(std::span<ExactSum> values) const {

@@ -137,10 +137,6 @@ class Decomposition {
   /// Over all ranks (collective).
   DecompositionStats stats() const;
 
-  /// The owners' values of every node of the whole model, in its node order,
-  /// on rank 0 (empty arrays elsewhere; collective).
-  std::vector<std::vector<Vec3>> gather_to_root(std::span<const std::span<const Vec3>> arrays) const;
-
   /// In place: every rank's accumulators become their sum over the ranks
   /// (exact; ~570 bytes per accumulator, whatever the model).
   void sum(std::span<ExactSum> values) const;

@@ -14,38 +14,13 @@
 
 #include "kernels/error.hpp"
 #include "runtime/hdf5_failure.hpp"
+#include "runtime/hdf5_rows.hpp"
 
 namespace shatter {
 
 namespace {
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 rows are written as 3 packed doubles");
-
-/// Owns one HDF5 identifier and closes it with the matching H5?close.
-class H5Id {
- public:
-  H5Id() = default;
-  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  H5Id(H5Id&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = H5I_INVALID_HID; }
-  H5Id& operator=(H5Id&& o) noexcept {
-    reset();
-    id_ = o.id_;
-    close_ = o.close_;
-    o.id_ = H5I_INVALID_HID;
-    return *this;
-  }
-  ~H5Id() { reset(); }
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-  void reset() {
-    if (id_ >= 0) close_(id_);
-    id_ = H5I_INVALID_HID;
-  }
-
- private:
-  hid_t id_ = H5I_INVALID_HID;
-  herr_t (*close_)(hid_t) = nullptr;
-};
 
 /// Wraps a freshly created identifier; throws naming `what` when HDF5 failed.
 H5Id checked(hid_t id, herr_t (*close)(hid_t), const std::string& what) {
@@ -57,44 +32,10 @@ void check(herr_t status, const std::string& what) {
   SHATTER_REQUIRE(status >= 0, "fields output: " << hdf5_write_failure(what));
 }
 
-/// Row placement of one rank's part of a global array.
-struct Rows {
-  hsize_t local = 0;   ///< rows this rank writes
-  hsize_t offset = 0;  ///< first global row of this rank
-  hsize_t total = 0;   ///< rows of all ranks
-};
-
-/// Creates dataset `name` in `group` with `rows.total` x `cols` entries
-/// (1-D when cols == 0) and writes this rank's rows collectively.
-void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, const void* data,
-                const Rows& rows, hsize_t cols) {
-  const int rank = cols == 0 ? 1 : 2;
-  const std::array<hsize_t, 2> dims{rows.total, cols};
-  const std::array<hsize_t, 2> local{rows.local, cols};
-  const std::array<hsize_t, 2> start{rows.offset, 0};
-  errno = 0;  // hdf5_write_failure reports the OS's reason of a failure in here
-  H5Id file_space = checked(H5Screate_simple(rank, dims.data(), nullptr), H5Sclose,
-                            std::string("create the dataspace of ") + name);
-  H5Id dset = checked(H5Dcreate2(group, name, file_type, file_space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                                 H5P_DEFAULT),
-                      H5Dclose, std::string("create dataset ") + name);
-  H5Id mem_space = checked(H5Screate_simple(rank, local.data(), nullptr), H5Sclose,
-                           std::string("create the memory space of ") + name);
-  if (rows.local == 0) {
-    // A rank without rows still joins the collective transfer.
-    check(H5Sselect_none(file_space.get()), "select nothing");
-    check(H5Sselect_none(mem_space.get()), "select nothing");
-  } else {
-    check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, local.data(),
-                              nullptr),
-          std::string("select the rows of ") + name);
-  }
-  H5Id xfer = checked(H5Pcreate(H5P_DATASET_XFER), H5Pclose, "create a transfer list");
-  check(H5Pset_dxpl_mpio(xfer.get(), H5FD_MPIO_COLLECTIVE), "request collective transfer");
-  static const double no_data = 0.0;
-  check(H5Dwrite(dset.get(), mem_type, mem_space.get(), file_space.get(), xfer.get(),
-                 data ? data : &no_data),
-        std::string("write dataset ") + name);
+/// The shared write_rows (hdf5_rows.hpp), its failures named "fields output".
+void write_rows(hid_t group, const char* name, hid_t mem_type, hid_t file_type, const void* data, const Rows& rows,
+                hsize_t cols) {
+  shatter::write_rows(group, name, mem_type, file_type, data, rows, cols, "fields output");
 }
 
 /// Rows of 6 in Voigt order xx yy zz yz xz xy, as XDMF's Tensor6 order xx xy xz yy yz zz.
@@ -290,9 +231,7 @@ FieldWriter::FieldWriter(const std::filesystem::path& dir, MPI_Comm comm)
   require_all(error, comm);
 
   const QuietHdf5 quiet;
-  H5Id fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create a file access list");
-  check(H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL), "select the MPI-IO driver");
-  check(H5Pset_coll_metadata_write(fapl.get(), true), "request collective metadata writes");
+  const H5Id fapl = mpio_access(comm, "fields output");
   errno = 0;
   s.file = H5Id(H5Fcreate(h5_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
   if (!all_ok(s.file.valid(), comm))

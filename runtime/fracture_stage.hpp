@@ -40,8 +40,8 @@ inline constexpr int kCohesiveSlots = 2 * 6;
 ///                  names each one's facet
 /// On parts (Model::holds_two_layers) a rank saves its part's state, node ids
 /// local, with whole_nodes, whole_cohesive and cohesive_whole to place it in
-/// the whole model's (FractureStage::gather); a checkpoint holds the whole
-/// model's state.
+/// the whole model's; a checkpoint holds the whole model's state, each row
+/// written by its owner (checkpoint.hpp CheckpointRows).
 struct FractureState {
   std::uint64_t mesh_revision = ~std::uint64_t{0};  ///< none copied yet
   std::vector<Vec3> reference;
@@ -152,12 +152,11 @@ class FractureStage {
   /// Frees the facets of `gids` held here (every rank's debonded(), by global
   /// id, the same list everywhere); returns how many the whole model freed.
   Index release(std::span<const GlobalId> gids);
-  /// The whole model's state on rank 0 (empty elsewhere) from `mine`, a state
-  /// saved here (save()) since the last insertion or earlier: each node from
-  /// its owner, each element's connectivity and each cohesive element (with
-  /// its facet's state) from its owner, which computes it. For checkpoints
-  /// on several ranks (runtime/fracture_parts.cpp). Collective.
-  FractureState gather(const FractureState& mine) const;
+  /// The cohesive elements of `mine`, a state saved here (save()) since the
+  /// last insertion or earlier, that this rank owns and writes to a
+  /// checkpoint (those whose facet's first element it owns), as indices into
+  /// mine's cohesive arrays, ascending by whole index (runtime/fracture_parts.cpp).
+  std::vector<Index> owned_cohesive(const FractureState& mine) const;
 
   Fragments fragments(std::span<const Vec3> x, std::span<const Vec3> v, std::span<const double> mass) const {
     return find_fragments(model_.mesh, topology_, x, v, mass);

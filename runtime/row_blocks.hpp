@@ -1,11 +1,12 @@
 #pragma once
 // Rows of a global array moved from their owners to contiguous blocks, one
-// per rank, for collective output in global order (fields.h5: each rank
-// writes one contiguous hyperslab, and the file is the same for any
-// decomposition). A hand-made two-phase write: one MPI_Alltoallv of the rows,
-// O(rows a rank holds) per rank.
+// per rank, for collective output in global order (fields.h5 and
+// checkpoint.h5: each rank writes one contiguous hyperslab, and the file is
+// the same for any decomposition). A hand-made two-phase write: one
+// MPI_Alltoallv of the rows, O(rows a rank holds) per rank.
 #include <mpi.h>
 
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -21,15 +22,15 @@ struct RowBlock {
 RowBlock row_block(Index total, int rank, int ranks);
 
 /// This rank's rows `rows` (global row ids, ascending; every row of [0,
-/// total) held by exactly one rank of `comm`) with `width` values each in
-/// `values` [rows.size() x width], sent to the ranks whose blocks hold them
-/// (collective). Returns this rank's block, [block.count x width], in row order.
+/// total) held by exactly one rank of `comm`) with `row_bytes` bytes each in
+/// `values` [rows.size() x row_bytes], sent to the ranks whose blocks hold
+/// them (collective). Returns this rank's block, [block.count x row_bytes],
+/// in row order.
+std::vector<std::byte> to_row_blocks(std::span<const Index> rows, std::span<const std::byte> values, int row_bytes,
+                                     Index total, MPI_Comm comm);
+
+/// As above, for rows of `width` doubles.
 std::vector<double> to_row_blocks(std::span<const Index> rows, std::span<const double> values, int width,
                                   Index total, MPI_Comm comm);
-
-/// As to_row_blocks, with every row going to rank 0 (checkpoints): rank 0
-/// returns the [total x width] array, the others an empty one.
-std::vector<double> to_root(std::span<const Index> rows, std::span<const double> values, int width, Index total,
-                            MPI_Comm comm);
 
 }  // namespace shatter

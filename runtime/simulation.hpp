@@ -243,6 +243,7 @@ class Simulation {
   ShellLoopResult last_shells_;
   double element_seconds_ = 0;
   double comm_seconds_ = 0;  ///< in MPI exchanges of the step (ghosts, shared nodes, granule sums)
+  double checkpoint_seconds_ = 0;  ///< writing periodic and stop checkpoints (wall, every rank takes part)
   /// inserting cohesive elements (splits, numbering, node lists): wall and thread CPU time
   double insert_seconds_ = 0, insert_cpu_seconds_ = 0;
   double total0_ = 0, energy_scale_ = 0;

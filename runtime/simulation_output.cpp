@@ -250,6 +250,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   j.add("time_per_step", step_ > 0 ? wall / step_ : 0.0);
   j.add("element_loop_time", element_seconds_);
   j.add("mesh_time", model_.mesh_seconds);
+  j.add("checkpoint_time", checkpoint_seconds_);
   // element-steps per second per core spent in the element loop (the elements computed: not rigid bodies')
   j.add("element_updates_per_second",
         element_seconds_ > 0 ? double(elements_.computed_elements() + (shells_ ? shells_->elements() : 0)) * (step_ + 1) / (element_seconds_ * opt_.threads)

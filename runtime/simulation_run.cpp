@@ -13,6 +13,7 @@
 #include "runtime/field_output.hpp"
 #include "runtime/report.hpp"
 #include "runtime/simulation.hpp"
+#include "runtime/timed.hpp"
 
 namespace shatter {
 
@@ -49,7 +50,7 @@ long Simulation::run() {
   if (!restored_) write_outputs(field_every > 0);
   // Checkpoints (checkpoint.hpp): periodic, on SIGINT/SIGTERM, and of the
   // last good state when a step fails. On
-  // several ranks, rank 0 writes the owners' values (save_checkpoint).
+  // several ranks, every rank writes its own rows (save_checkpoint).
   const std::filesystem::path checkpoint = opt_.out_dir / "checkpoint.h5";
   const bool checkpoints = !opt_.out_dir.empty();
   SimulationState good;  // the state before the current step
@@ -94,7 +95,7 @@ long Simulation::run() {
                                          now - last_checkpoint >= std::chrono::duration<double>(every->every_seconds)));
     if (checkpoints && (due || stop) && !last) {
       save_state(good);
-      save_checkpoint(checkpoint, good);
+      timed(checkpoint_seconds_, [&] { save_checkpoint(checkpoint, good); });
       last_checkpoint = now;
     }
     if (stop) {

@@ -2,14 +2,12 @@
 // step as the last good state, restored for --restart, written as a
 // checkpoint (runtime/checkpoint.hpp).
 #include <algorithm>
-#include <optional>
 
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/contact_stage.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/fracture_stage.hpp"
-#include "runtime/row_blocks.hpp"
 #include "runtime/simulation.hpp"
 
 #include "runtime/loads.hpp"
@@ -19,42 +17,23 @@
 namespace shatter {
 
 void Simulation::save_checkpoint(const std::filesystem::path& path, SimulationState& s, const std::string& reason) {
-  if (dec_->distributed()) {
-    // Every node's values from its owner, in the whole model's node order, on
-    // rank 0; the reactions through a nodal array, with a flag per node that has them.
-    const Index n = model_.mesh.num_nodes();
-    std::vector<Vec3> reaction(n, Vec3::Zero()), has(n, Vec3::Zero());
-    for (size_t b = 0; b < bc_nodes_.size(); ++b) reaction[bc_nodes_[b]] = s.reaction[b], has[bc_nodes_[b]].x() = 1;
-    const std::span<const Vec3> arrays[] = {s.x, s.v, s.a, s.f_int, s.f_ext, reaction, has};
-    std::vector<std::vector<Vec3>> whole;
-    timed(comm_seconds_, [&] { whole = dec_->gather_to_root(arrays); });
-    if (dec_->rank() == 0) {
-      s.x = std::move(whole[0]), s.v = std::move(whole[1]), s.a = std::move(whole[2]);
-      s.f_int = std::move(whole[3]), s.f_ext = std::move(whole[4]);
-      s.reaction.clear();
-      for (size_t i = 0; i < whole[6].size(); ++i)
-        if (whole[6][i].x() != 0) s.reaction.push_back(whole[5][i]);
-    }
+  if (!dec_->distributed()) return write_checkpoint(path, model_, s, reason);
+  // Every rank writes its own rows (checkpoint.hpp): a node's from the
+  // smallest rank touching it, an element's and a cohesive element's from
+  // their owners. The failure text is rank 0's, the one the file holds.
+  CheckpointRows rows;
+  rows.comm = dec_->comm();
+  const size_t nodes = s.fracture ? std::min(s.x.size(), s.fracture->reference.size()) : s.x.size();
+  for (Index n : dec_->touched_nodes())
+    if (static_cast<size_t>(n) < nodes && dec_->node_owner(n) == dec_->rank()) rows.nodes.push_back(n);
+  std::sort(rows.nodes.begin(), rows.nodes.end(),
+            [&](Index a, Index b) { return model_.whole_node(a) < model_.whole_node(b); });
+  if (fracture_) {
+    rows.elements.assign(dec_->owned_element_ids().begin(), dec_->owned_element_ids().end());
+    rows.cohesive = fracture_->owned_cohesive(*s.fracture);
   }
-  // The whole model's fracture state, from the owners, in place of rank 0's own
-  // until the checkpoint is written (the next saves fill in their own).
-  std::optional<FractureState> mine;
-  if (fracture_ && dec_->distributed()) {
-    FractureState whole;
-    timed(comm_seconds_, [&] { whole = fracture_->gather(*s.fracture); });
-    if (dec_->rank() == 0) {
-      mine = std::move(*s.fracture);
-      *s.fracture = std::move(whole);
-    }
-  }
-  std::string failure;
-  if (dec_->rank() == 0) try {
-      write_checkpoint(path, model_, s, reason);
-    } catch (const Error& e) {
-      failure = e.what();
-    }
-  if (mine) *s.fracture = std::move(*mine);
-  if (dec_->max(failure.empty() ? 0 : 1)) throw Error(failure.empty() ? "writing the checkpoint failed on rank 0" : failure);
+  write_checkpoint(path, model_, s, dec_->broadcast(reason, 0), &rows);
+
 }
 
 void Simulation::save_state(SimulationState& s) const {

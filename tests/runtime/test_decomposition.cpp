@@ -18,6 +18,7 @@
 #include "runtime/fragment_labels.hpp"
 #include "runtime/model_part.hpp"
 #include "runtime/model.hpp"
+#include "runtime/row_blocks.hpp"
 #include "runtime/simulation.hpp"
 #include "scene_text.hpp"
 
@@ -97,7 +98,7 @@ TEST(Decomposition, OwnershipCoversEverythingOnce) {
   }
 }
 
-TEST(Decomposition, GhostUpdateAndGatherDeliverTheOwnersValues) {
+TEST(Decomposition, GhostUpdateAndRowBlocksDeliverTheOwnersValues) {
   const Model& m = box();
   Decomposition d(m, MPI_COMM_WORLD);
   const Index nn = m.mesh.num_nodes();
@@ -107,17 +108,20 @@ TEST(Decomposition, GhostUpdateAndGatherDeliverTheOwnersValues) {
   d.begin_ghost_update(x);
   d.end_ghost_update(x);
   for (Index n : d.held_nodes()) EXPECT_TRUE(same_bits(x[n], tag(n))) << "node " << n;
-  // Gather all to rank 0.
-  std::vector<Vec3> y(nn, Vec3::Constant(-7.0)), z(nn, Vec3::Constant(-7.0));
-  for (Index n : d.touched_nodes()) y[n] = tag(n), z[n] = -tag(n);
-  const std::span<const Vec3> owned[] = {y, z};
-  const std::vector<std::vector<Vec3>> whole = d.gather_to_root(owned);
-  if (d.rank() == 0) {
-    ASSERT_EQ(whole[1].size(), static_cast<size_t>(nn));
-    for (Index n = 0; n < nn; ++n)
-      EXPECT_TRUE(same_bits(whole[0][n], tag(n)) && same_bits(whole[1][n], Vec3(-tag(n)))) << "node " << n;
-  } else {
-    EXPECT_TRUE(whole[0].empty());
+  // Each node's row from its owner to the rank whose contiguous block holds
+  // it (row_blocks.hpp: how checkpoints and fields are written).
+  std::vector<Index> rows;
+  std::vector<Vec3> values;
+  for (Index n : d.touched_nodes())
+    if (d.node_owner(n) == d.rank()) rows.push_back(n), values.push_back(tag(n));
+  const std::vector<std::byte> block =
+      to_row_blocks(rows, std::as_bytes(std::span<const Vec3>(values)), sizeof(Vec3), nn, MPI_COMM_WORLD);
+  const RowBlock b = row_block(nn, d.rank(), d.size());
+  ASSERT_EQ(block.size(), static_cast<size_t>(b.count) * sizeof(Vec3));
+  for (Index i = 0; i < b.count; ++i) {
+    Vec3 v;
+    std::memcpy(v.data(), block.data() + static_cast<size_t>(i) * sizeof(Vec3), sizeof(Vec3));
+    EXPECT_TRUE(same_bits(v, tag(b.first + i))) << "node " << b.first + i;
   }
   // allgather: the ranks' lists in rank order.
   const std::vector<Index> mine(d.rank() + 1, d.rank());
