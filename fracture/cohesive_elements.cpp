@@ -118,6 +118,14 @@ void scatter_block(const CohesiveElements& coh, const ShareView& which, int k, I
 
 }  // namespace
 
+std::vector<Index> Insertion::changed_nodes() const {
+  std::vector<Index> nodes;
+  for (const auto& [copy, parent] : new_nodes) nodes.insert(nodes.end(), {copy, parent});
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
 Insertion insert_cohesive_elements(Mesh& mesh, Topology& topo, CohesiveElements& coh,
                                    std::span<const Index> facets) {
   const int k = mesh.order == 1 ? 3 : 6;

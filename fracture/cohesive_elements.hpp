@@ -59,6 +59,8 @@ struct Insertion {
   std::vector<std::array<Index, 2>> crack_faces;
   /// The new cohesive elements are [first_cohesive, cohesive.size()).
   Index first_cohesive = 0;
+  /// The nodes whose element stars changed: the split nodes and their copies, ascending.
+  std::vector<Index> changed_nodes() const;
 };
 
 /// Insert cohesive elements on the given intact interior facets, which must

@@ -23,14 +23,8 @@ NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part) {
   NodeRanks t;
   const Index nn = mesh.num_nodes();
   t.offsets.assign(static_cast<size_t>(nn) + 1, 0);
-  std::vector<int> star;
   for (Index n = 0; n < nn; ++n) {
-    star.clear();
-    for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
-      star.push_back(elem_part[mesh.node_elem[p]]);
-    std::sort(star.begin(), star.end());
-    star.erase(std::unique(star.begin(), star.end()), star.end());
-    t.ranks.insert(t.ranks.end(), star.begin(), star.end());
+    append_star_ranks(mesh, n, [&](Index e) { return elem_part[e]; }, t.ranks);
     t.offsets[n + 1] = static_cast<Index>(t.ranks.size());
   }
   return t;

@@ -2,6 +2,8 @@
 // Volume decomposition (DESIGN.md "Parallel model", docs/parallel.md): a
 // METIS k-way partition of the granule graph, the ranks touching each node,
 // and the node lists ranks exchange (runtime/decomposition.hpp uses them).
+#include <algorithm>
+#include <cstddef>
 #include <map>
 #include <span>
 #include <vector>
@@ -47,6 +49,17 @@ struct NodeRanks {
 /// The ranks touching each node (owning an element that uses it), from the
 /// mesh's node -> element CSR and the part of every element.
 NodeRanks touching_ranks(const Mesh& mesh, std::span<const int> elem_part);
+
+/// Appends to `out` the parts part_of(e) of the elements e around node n,
+/// ascending and distinct: node n's entry of touching_ranks.
+template <class PartOf>
+void append_star_ranks(const Mesh& mesh, Index n, PartOf part_of, std::vector<int>& out) {
+  const auto first = static_cast<std::ptrdiff_t>(out.size());
+  for (Index p = mesh.node_elem_offsets[n]; p < mesh.node_elem_offsets[n + 1]; ++p)
+    out.push_back(part_of(mesh.node_elem[p]));
+  std::sort(out.begin() + first, out.end());
+  out.erase(std::unique(out.begin() + first, out.end()), out.end());
+}
 
 /// Nodes exchanged with other ranks, grouped by rank: the nodes for ranks[i]
 /// are nodes[offsets[i] .. offsets[i+1]) (local node ids, in an order both

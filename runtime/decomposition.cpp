@@ -93,6 +93,13 @@ NodeRanks granule_touching_ranks(const Mesh& mesh, std::span<const int> granule_
   return touching_ranks(mesh, elem_part);
 }
 
+Index Decomposition::home_granule_of(Index n) const {
+  const Mesh& mesh = model_.mesh;
+  if (is_shell_node(n)) return first_shell_granule_ + shell_position_[n - first_shell_node_] / kShellGranule;
+  if (mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]) return -1;
+  return model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
+}
+
 void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width) {
   const Mesh& mesh = model_.mesh;
   const Index ne = mesh.num_elements(), nn = mesh.num_nodes();
@@ -104,11 +111,7 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
   // On a part, a ghost-only node's star may not be whole here, but none of
   // it is owned here, so neither is the granule computed; a contact-surface
   // node outside the part's elements has no star and no home granule (-1).
-  for (Index n = 0; n < nn; ++n)
-    home_granule_[n] = is_shell_node(n) ? first_shell_granule_ + shell_position_[n - first_shell_node_] / kShellGranule
-                       : mesh.node_elem_offsets[n] == mesh.node_elem_offsets[n + 1]
-                           ? -1
-                           : model_.whole_element(mesh.node_elem[mesh.node_elem_offsets[n]]) / ElementForces::kGranule;
+  for (Index n = 0; n < nn; ++n) home_granule_[n] = home_granule_of(n);
   {
     std::vector<Index> slot(num_granules(), -1);
     for (size_t k = 0; k < owned_granules_.size(); ++k) slot[owned_granules_[k]] = static_cast<Index>(k);
@@ -161,10 +164,6 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     node_rank_offsets_ = std::move(offsets);
     node_ranks_ = std::move(ranks);
   }
-  auto touches = [&](Index n, int r) {
-    return std::binary_search(node_ranks_.begin() + node_rank_offsets_[n],
-                              node_ranks_.begin() + node_rank_offsets_[n + 1], r);
-  };
 
   touched_nodes_.clear();
   local_elements_.clear();
@@ -217,7 +216,10 @@ void Decomposition::rebuild_nodes(std::span<const Index> groups, int group_width
     if (held[n]) held_nodes_.push_back(n);
 
   // Receive: ghost-only nodes (held, not touched) from their owners.
-  std::map<int, std::vector<Index>> recv, send;
+  std::map<int, std::vector<Index>>& recv = recv_;
+  std::map<int, std::vector<Index>>& send = send_;
+  recv.clear();
+  send.clear();
   ghost_only_nodes_.clear();
   for (Index n : held_nodes_)
     if (!touches(n, rank_)) {

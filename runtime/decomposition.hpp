@@ -36,6 +36,9 @@
 // 2-ring ghost layer).
 #include <mpi.h>
 
+#include <algorithm>
+#include <functional>
+#include <map>
 #include <memory>
 #include <span>
 #include <vector>
@@ -78,6 +81,20 @@ class Decomposition {
   /// with a node it touches (it computes those groups' forces;
   /// docs/parallel.md "Cohesive elements on ranks").
   void rebuild_nodes(std::span<const Index> groups = {}, int group_width = 1);
+  /// The groups holding a node (indices into rebuild_nodes' groups, in any order,
+  /// repeats allowed), appended to the vector.
+  using GroupsOfNode = std::function<void(Index node, std::vector<Index>& out)>;
+  /// rebuild_nodes after an insertion, with the same lists and halo plan, but
+  /// recomputed only around what changed (docs/parallel.md "Cohesive elements
+  /// on ranks"): `changed`, ascending, holds every node whose element star
+  /// changed (the split nodes and their new copies, which follow the nodes of
+  /// the last rebuild); groups [0, old_groups) were there at the last rebuild
+  /// and changed only in their nodes of `changed`; groups_of lists the groups
+  /// around a node. The work is that of the changed nodes' stars and groups
+  /// and of their neighbours, and of copying the lists, not of the part's
+  /// elements. (With shell nodes, rebuild_nodes.)
+  void update_nodes(std::span<const Index> changed, std::span<const Index> groups, int group_width,
+                    Index old_groups, const GroupsOfNode& groups_of);
 
   int rank() const { return rank_; }
   int size() const { return size_; }
@@ -116,6 +133,11 @@ class Decomposition {
     if (size_ == 1) return {};
     return {node_ranks_.data() + node_rank_offsets_[node],
             static_cast<size_t>(node_rank_offsets_[node + 1] - node_rank_offsets_[node])};
+  }
+  /// Whether rank r touches the node (on several ranks).
+  bool touches(Index node, int r) const {
+    return std::binary_search(node_ranks_.begin() + node_rank_offsets_[node],
+                              node_ranks_.begin() + node_rank_offsets_[node + 1], r);
   }
   /// The smallest rank touching the node.
   int node_owner(Index node) const { return size_ == 1 ? 0 : node_ranks_[node_rank_offsets_[node]]; }
@@ -193,6 +215,11 @@ class Decomposition {
   std::vector<Index> owned_nodes_, owned_element_ids_;
   std::vector<Index> home_granule_;               ///< per node
   std::vector<Index> home_offsets_, home_nodes_;  ///< CSR over the owned granules' index k
+  /// Per rank, the nodes sent to it / received from it per ghost update, ascending (the halo plan).
+  std::map<int, std::vector<Index>> send_, recv_;
+  /// Node n's home granule: the granule of the first element of its star (a
+  /// shell node's own granule; -1 for a node in no element).
+  Index home_granule_of(Index n) const;
   std::unique_ptr<Halo> halo_;
 };
 

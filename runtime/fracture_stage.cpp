@@ -56,6 +56,7 @@ FractureStage::FractureStage(Model& model, const Decomposition& dec)
     if (topology_.is_interior(f)) by_gid_.push_back(f);
   std::sort(by_gid_.begin(), by_gid_.end(),
             [&](Index a, Index b) { return topology_.facet_gid[a] < topology_.facet_gid[b]; });
+  for (const Index f : by_gid_) sorted_gids_.push_back(topology_.facet_gid[f]);
 }
 
 std::vector<GlobalId> FractureStage::gids(std::span<const Index> facets) const {
@@ -68,9 +69,8 @@ std::vector<GlobalId> FractureStage::gids(std::span<const Index> facets) const {
 std::vector<Index> FractureStage::facets(std::span<const GlobalId> gids) const {
   std::vector<Index> out;
   for (GlobalId g : gids) {
-    const auto it = std::lower_bound(by_gid_.begin(), by_gid_.end(), g,
-                                     [&](Index f, GlobalId v) { return topology_.facet_gid[f] < v; });
-    if (it != by_gid_.end() && topology_.facet_gid[*it] == g) out.push_back(*it);
+    const auto it = std::lower_bound(sorted_gids_.begin(), sorted_gids_.end(), g);
+    if (it != sorted_gids_.end() && *it == g) out.push_back(by_gid_[it - sorted_gids_.begin()]);
   }
   return out;
 }
@@ -115,15 +115,41 @@ void FractureStage::share() {
   computed_.clear();
   owned_.clear();
   if (!dec_.distributed()) return;
-  std::vector<char> touched(model_.mesh.num_nodes(), 0);
-  for (Index n : dec_.touched_nodes()) touched[n] = 1;
-  for (Index c = 0; c < cohesive_.size(); ++c) {
-    const Index* nodes = cohesive_.side_nodes.data() + static_cast<size_t>(c) * kCohesiveSlots;
-    if (std::none_of(nodes, nodes + kCohesiveSlots, [&](Index n) { return n >= 0 && touched[n]; })) continue;
-    computed_.push_back(c);
-    owned_.push_back(dec_.owns_element(topology_.facet_elem[cohesive_.facet[c]][0]) ? 1 : 0);
-  }
+  for (Index c = 0; c < cohesive_.size(); ++c) share_one(c);
   // (A rank owning a cohesive element touches its first element's nodes: it computes it.)
+}
+
+void FractureStage::share_one(Index c) {
+  const Index* nodes = cohesive_.side_nodes.data() + static_cast<size_t>(c) * kCohesiveSlots;
+  if (std::none_of(nodes, nodes + kCohesiveSlots, [&](Index n) { return n >= 0 && dec_.touches(n, dec_.rank()); }))
+    return;
+  computed_.push_back(c);
+  owned_.push_back(dec_.owns_element(topology_.facet_elem[cohesive_.facet[c]][0]) ? 1 : 0);
+}
+
+void FractureStage::share(const Insertion& ins) {
+  if (!dec_.distributed()) return;
+  std::vector<Index> near;
+  for (const Index n : ins.changed_nodes()) cohesive_around(n, near);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  std::vector<char> is_near(cohesive_.size(), 0);
+  for (const Index c : near) is_near[c] = 1;
+  // The others kept, in order, with the near ones (older than the new ones) merged in.
+  std::vector<Index> computed = std::move(computed_);
+  std::vector<std::uint8_t> owned = std::move(owned_);
+  computed_.clear();
+  owned_.clear();
+  auto c = near.begin();
+  for (size_t i = 0; i < computed.size(); ++i) {
+    if (is_near[computed[i]]) continue;
+    for (; c != near.end() && *c < computed[i]; ++c) share_one(*c);
+    computed_.push_back(computed[i]);
+    owned_.push_back(owned[i]);
+  }
+  for (; c != near.end(); ++c)
+    if (*c < ins.first_cohesive) share_one(*c);
+  for (Index fresh = ins.first_cohesive; fresh < cohesive_.size(); ++fresh) share_one(fresh);
 }
 
 CohesiveEnergy FractureStage::add_forces(std::span<const Vec3> x, std::span<Vec3> f_int) {
@@ -151,7 +177,25 @@ Insertion FractureStage::insert(std::span<const GlobalId> gids) {
                                                                                     topology_.facet_gid[cohesive_.facet[c]]) -
                                                                    sorted.begin()));
   whole_cohesive_ += static_cast<Index>(sorted.size());
+  index_cohesive(ins.first_cohesive);
   return ins;
+}
+
+void FractureStage::index_cohesive(Index first) {
+  facet_cohesive_.resize(topology_.num_facets(), -1);
+  for (Index c = first; c < cohesive_.size(); ++c) facet_cohesive_[cohesive_.facet[c]] = c;
+}
+
+void FractureStage::cohesive_around(Index n, std::vector<Index>& out) const {
+  const Mesh& mesh = model_.mesh;
+  const int k = mesh.order == 1 ? 3 : 6;
+  for (const Index e : node_star(mesh, n))
+    for (int i = 0; i < 4; ++i) {
+      const Index c = facet_cohesive_[topology_.elem_facet[static_cast<size_t>(e) * 4 + i]];
+      if (c < 0) continue;
+      const std::array<Index, 6> face = face_nodes(mesh, e, i);
+      if (std::find(face.begin(), face.begin() + k, n) != face.begin() + k) out.push_back(c);
+    }
 }
 
 double FractureStage::eigenvalue_bound(std::span<const double> mass) {
@@ -289,6 +333,8 @@ void FractureStage::restore(const FractureState& whole) {
   ++facet_revision_;
   cohesive_ = s.cohesive;
   cohesive_.facet = cohesive_facets;
+  facet_cohesive_.assign(topology_.num_facets(), -1);
+  index_cohesive(0);
   if (model_.holds_two_layers()) {
     whole_cohesive_ = s.whole_cohesive;
     cohesive_whole_ = s.cohesive_whole;

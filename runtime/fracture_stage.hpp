@@ -104,6 +104,10 @@ class FractureStage {
   /// after every insertion, split or restore, once the decomposition knows
   /// the nodes.
   void share();
+  /// share() after `ins`, the last insertion (the decomposition updated):
+  /// only the cohesive elements around its changed nodes, and the new ones,
+  /// are looked at again (the others' nodes and their touching ranks are as they were).
+  void share(const Insertion& ins);
 
   /// Facet global ids (Topology::facet_gid) of `facets`, and back: the
   /// interior facets held here among `gids` (others skipped). Facet lists
@@ -113,6 +117,10 @@ class FractureStage {
   /// The cohesive elements' side nodes, kCohesiveSlots per element (-1 for
   /// unused slots): the node groups of Decomposition::rebuild_nodes.
   std::span<const Index> side_nodes() const { return cohesive_.side_nodes; }
+  /// Appends to `out` the cohesive elements with node n among their side
+  /// nodes (Decomposition::update_nodes' groups_of): those on the facets
+  /// through n of the elements around n.
+  void cohesive_around(Index n, std::vector<Index>& out) const;
 
   /// Adds the forces dE/dx at positions x of the cohesive elements this rank
   /// computes to f_int (the nodes it touches get every term); returns the
@@ -204,7 +212,16 @@ class FractureStage {
   const Decomposition& dec_;
   Topology topology_;
   std::vector<Index> by_gid_;  ///< interior facets, ascending by facet_gid
+  /// Their facet_gid, ascending: facets() searches the whole model's lists
+  /// here, without reading the topology at every step of the search.
+  std::vector<GlobalId> sorted_gids_;
   CohesiveElements cohesive_;
+  /// Per facet, its cohesive element (-1: none), for cohesive_around.
+  std::vector<Index> facet_cohesive_;
+  /// Fills facet_cohesive_ for the cohesive elements [first, size).
+  void index_cohesive(Index first);
+  /// Lists cohesive element c in computed_ (and owned_) when it has a node touched here.
+  void share_one(Index c);
   std::vector<Index> cohesive_whole_;  ///< [c]: index among the whole model's cohesive elements
   Index whole_cohesive_ = 0;           ///< the whole model's cohesive elements
   /// The part's own state from its read of a checkpoint (`read`: FractureState::node_rows;

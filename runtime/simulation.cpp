@@ -340,10 +340,11 @@ void Simulation::apply_fracture() {
   if (model_.holds_two_layers())
     timed(comm_seconds_, [&] { created = number_split_nodes(model_, model_.mesh.num_nodes() - here, revision, *dec_); });
   timed(insert_seconds_, insert_cpu_seconds_, [&] {
-    dec_->rebuild_nodes(fracture_->side_nodes(), kCohesiveSlots);
+    dec_->update_nodes(ins.changed_nodes(), fracture_->side_nodes(), kCohesiveSlots, ins.first_cohesive,
+                       [&](Index n, std::vector<Index>& out) { fracture_->cohesive_around(n, out); });
     // After the node lists: the contact patch asks who owns the new nodes.
     if (contact_ && (freed > 0 || here > 0)) rebuild_contact_surface();
-    share_plans();
+    share_plans(&ins);
   });
   // The split nodes' masses and forces changed: recompute the accelerations
   // that the next half step uses (the velocities were copied, so momentum is
@@ -366,8 +367,9 @@ void Simulation::count_contact_vertices() {
     if (dec_->owns_node(i)) contact_vertices_.push_back(i);
 }
 
-void Simulation::share_plans() {
-  if (fracture_) fracture_->share();
+void Simulation::share_plans(const Insertion* after) {
+  if (fracture_ && after) fracture_->share(*after);
+  else if (fracture_) fracture_->share();
   if (!dec_->distributed()) return;
   elements_.restrict_to(dec_->local_elements(), dec_->held_nodes(), dec_->ghost_only_nodes());
   if (shells_) shells_->restrict_to(dec_->touched_nodes(), [&](Index n) { return dec_->owns_node(n); });

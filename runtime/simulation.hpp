@@ -219,8 +219,10 @@ class Simulation {
   ElementForces elements_;
   std::array<ExactSum, kStepWorks> step_work_;  ///< since the last update_ledger(), this rank's part
   /// After a topology change on several ranks: restrict the element loop to
-  /// the local elements, renew the plans of the shared nodes.
-  void share_plans();
+  /// the local elements, renew the plans of the shared nodes; `after`: the
+  /// insertion that changed it, if any (the cohesive elements are then shared
+  /// again only around it).
+  void share_plans(const Insertion* after = nullptr);
   /// The contact surface of the cracked mesh, without the bonded cohesive facets' faces.
   void rebuild_contact_surface();
   /// contact_vertices_ from the surface and the node ownership.

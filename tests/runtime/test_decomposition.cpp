@@ -5,6 +5,7 @@
 // serial forces bit for bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -392,6 +393,72 @@ TEST(Decomposition, FractureRestartOnPartsReadsItsOwnRows) {
       ++checked;
     }
   EXPECT_GT(checked, 0);
+}
+
+TEST(Decomposition, UpdateAfterInsertionEqualsRebuild) {
+  // update_nodes, around the split nodes only, leaves the lists and the halo
+  // plan that rebuild_nodes makes over the whole part; three rounds of
+  // insertion on the parts of two ghost layers, the later ones splitting copies.
+  const Scene scene = rank_scene(
+      "fracture_update",
+      "name: fracture_update\ntime: {end: 1.0}\nmaterials:\n"
+      "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3,\n"
+      "          fracture: {strength: 3.0e8, energy: 100.0, beta: 1.0}}\n"
+      "bodies:\n  - {name: b, material: steel, mesh: {shape: box, size: [0.02, 0.016, 0.012], element_size: 0.002}}\n");
+  Model part = build_model(scene, MPI_COMM_WORLD);
+  Decomposition updated(part, MPI_COMM_WORLD), rebuilt(part, MPI_COMM_WORLD);
+  FractureStage stage(part, updated);
+  const Topology& t = stage.topology();
+  auto name_tag = [&](Index n) -> Vec3 {
+    return tag(0) + static_cast<double>(part.mesh.node_gid[n]) * Vec3(1.0, 0.5, -3.0);
+  };
+  auto same = [](std::span<const Index> a, std::span<const Index> b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end());
+  };
+  long split = 0;
+  for (int round : {0, 1, 2}) {
+    // Every rank's choice of its facets, the same list everywhere.
+    std::vector<GlobalId> mine;
+    for (Index f = 0; f < t.num_facets(); ++f)
+      if (t.is_interior(f) && t.facet_state[f] == FacetState::intact &&
+          (static_cast<std::uint64_t>(t.facet_gid[f]) * 2654435761u + round) % 100 < 15)
+        mine.push_back(t.facet_gid[f]);
+    std::vector<GlobalId> gids = updated.allgather(std::span<const GlobalId>(mine));
+    std::sort(gids.begin(), gids.end());
+    gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
+    const std::uint64_t revision = part.mesh.revision;
+    const Index before = part.mesh.num_nodes();
+    const Insertion ins = stage.insert(gids);
+    split += static_cast<long>(ins.new_nodes.size());
+    part.bc_mask.resize(part.mesh.num_nodes(), 0);
+    if (part.holds_two_layers()) number_split_nodes(part, before, revision, updated);
+    updated.update_nodes(ins.changed_nodes(), stage.side_nodes(), kCohesiveSlots, ins.first_cohesive,
+                         [&](Index n, std::vector<Index>& out) { stage.cohesive_around(n, out); });
+    rebuilt.rebuild_nodes(stage.side_nodes(), kCohesiveSlots);
+    EXPECT_TRUE(same(updated.local_elements(), rebuilt.local_elements())) << "round " << round;
+    EXPECT_TRUE(same(updated.held_nodes(), rebuilt.held_nodes())) << "round " << round;
+    EXPECT_TRUE(same(updated.touched_nodes(), rebuilt.touched_nodes())) << "round " << round;
+    EXPECT_TRUE(same(updated.ghost_only_nodes(), rebuilt.ghost_only_nodes())) << "round " << round;
+    EXPECT_TRUE(same(updated.owned_nodes(), rebuilt.owned_nodes())) << "round " << round;
+    for (size_t k = 0; k < updated.owned_granules().size(); ++k)
+      EXPECT_TRUE(same(updated.home_nodes(k), rebuilt.home_nodes(k))) << "round " << round << " granule " << k;
+    for (Index n = 0; n < part.mesh.num_nodes(); ++n) {
+      const auto a = updated.node_ranks(n), b = rebuilt.node_ranks(n);
+      ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "round " << round << " node " << n;
+    }
+    EXPECT_EQ(updated.ghost_bytes(), rebuilt.ghost_bytes()) << "round " << round;
+    // Both plans deliver the owners' values (named by the nodes' global ids).
+    for (const Decomposition* d : {&updated, &rebuilt}) {
+      std::vector<Vec3> x(part.mesh.num_nodes(), Vec3::Constant(-7.0));
+      for (Index n : d->touched_nodes()) x[n] = name_tag(n);
+      d->begin_ghost_update(x);
+      d->end_ghost_update(x);
+      for (Index n : d->held_nodes())
+        ASSERT_TRUE(same_bits(x[n], name_tag(n)))
+            << "round " << round << " node " << n << (d == &updated ? " (updated)" : " (rebuilt)");
+    }
+  }
+  EXPECT_GT(split, 0);
 }
 
 }  // namespace
