@@ -29,7 +29,7 @@ if "fracture" in f:
 print(f"checkpoint at step {f.attrs['step']}")
 PY
 for n in 2 3 4; do
-  /usr/bin/python3 "$here/same_checkpoint.py" "$work/r1/checkpoint.h5" "$work/r$n/checkpoint.h5" ||
+  /usr/bin/python3 "$here/same_h5.py" "$work/r1/checkpoint.h5" "$work/r$n/checkpoint.h5" ||
     { echo "FAIL: the checkpoint of $n ranks differs from that of 1 rank"; exit 1; }
 done
 cp "$work/r4/checkpoint.h5" "$work/spoiled.h5"

@@ -47,7 +47,7 @@ for d in r2t1 r1t2 r3t1 r4t1; do
   done
   # Field frames (when the scene writes them): every dataset the same bits.
   if [ -f "$work/r1t1/fields.h5" ]; then
-    /usr/bin/python3 "$(dirname "$0")/same_fields.py" "$work/r1t1/fields.h5" "$work/$d/fields.h5" > /dev/null ||
+    /usr/bin/python3 "$(dirname "$0")/same_h5.py" "$work/r1t1/fields.h5" "$work/$d/fields.h5" > /dev/null ||
       { echo "FAIL: $d/fields.h5 differs from r1t1/fields.h5"; status=1; }
     cmp -s "$work/r1t1/fields.xdmf" "$work/$d/fields.xdmf" || { echo "FAIL: $d/fields.xdmf differs"; status=1; }
   fi

@@ -1,9 +1,9 @@
-"""Exit 1 unless two checkpoint.h5 files hold the same groups, datasets and
-attributes, with the same bits (tests/mpi/same_checkpoint.sh: a checkpoint
-written collectively, each rank its own rows, must not depend on the number of
-ranks).
+"""Exit 1 unless two HDF5 files hold the same groups, datasets and attributes,
+with the same bits: the field frames (tests/mpi/same_history.sh) and the
+checkpoints (tests/mpi/same_checkpoint.sh) written from blocks of each rank's
+own rows must not depend on the decomposition.
 
-usage: same_checkpoint.py A.h5 B.h5"""
+usage: same_h5.py A.h5 B.h5"""
 import sys
 
 import h5py
