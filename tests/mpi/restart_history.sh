@@ -12,7 +12,11 @@ rm -rf "$work"
 mkdir -p "$work"
 "$shatter" run "$scene" --out "$work/whole" --threads 1 --quiet || { echo "FAIL: the uninterrupted run"; exit 1; }
 rows=$(wc -l < "$work/whole/history.csv")
-"${mpi[@]}" -n 4 "$shatter" run "$scene" --out "$work/cut" --threads 1 --quiet 2> "$work/cut.log" &
+# mpirun forwards the signal to the ranks and kills them odls_base_sigkill_timeout
+# seconds later (Open MPI's default: 1 s); the ranks' stop and checkpoint, a
+# collective write, need longer on a loaded machine (docs/checkpoint.md).
+OMPI_MCA_odls_base_sigkill_timeout=30 \
+  "${mpi[@]}" -n 4 "$shatter" run "$scene" --out "$work/cut" --threads 1 --quiet 2> "$work/cut.log" &
 job=$!
 # Stop it after about a third of the rows.
 for _ in $(seq 1 $((600 * ${SHATTER_TEST_TIMEOUT_SCALE:-1}))); do
