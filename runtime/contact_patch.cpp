@@ -7,6 +7,7 @@
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/halo.hpp"
+#include "runtime/sort_unique.hpp"
 
 namespace shatter {
 
@@ -16,11 +17,6 @@ namespace {
 template <size_t K>
 void add_nodes(std::span<const std::array<Index, K>> primitives, std::vector<Index>& nodes) {
   for (const auto& p : primitives) nodes.insert(nodes.end(), p.begin(), p.end());
-}
-
-void sort_unique(std::vector<Index>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 Box empty_box() {
@@ -59,8 +55,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
       if (r != dec.rank()) touching_.push_back(r);
     if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
-  std::sort(touching_.begin(), touching_.end());
-  touching_.erase(std::unique(touching_.begin(), touching_.end()), touching_.end());
+  sort_unique(touching_);
 }
 
 ContactPatch::~ContactPatch() = default;
@@ -197,8 +192,7 @@ void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,
   neighbors_ = touching_;
   for (const auto* plan : {&send, &receive})
     for (const auto& [r, list] : *plan) neighbors_.push_back(r);
-  std::sort(neighbors_.begin(), neighbors_.end());
-  neighbors_.erase(std::unique(neighbors_.begin(), neighbors_.end()), neighbors_.end());
+  sort_unique(neighbors_);
   // Each home node's readers: the ranks it is sent to, and the other ranks touching it.
   const auto& home = volume_vertices_.vertices;
   std::vector<std::vector<int>> readers(home.size());
@@ -209,8 +203,7 @@ void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,
   for (size_t k = 0; k < home.size(); ++k) {
     for (const int r : dec_.node_ranks(home[k]))
       if (r != me) readers[k].push_back(r);
-    std::sort(readers[k].begin(), readers[k].end());
-    readers[k].erase(std::unique(readers[k].begin(), readers[k].end()), readers[k].end());
+    sort_unique(readers[k]);
     readers_.insert(readers_.end(), readers[k].begin(), readers[k].end());
     reader_offsets_.push_back(static_cast<Index>(readers_.size()));
   }

@@ -8,6 +8,7 @@
 #include "mesh/partition.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/halo.hpp"
+#include "runtime/sort_unique.hpp"
 
 namespace shatter {
 namespace {
@@ -38,11 +39,6 @@ void patch(std::map<int, std::vector<Index>>& lists, const std::vector<char>& dr
     patch(it->second, drop, found == add.end() ? none : found->second);
     it = it->second.empty() ? lists.erase(it) : std::next(it);
   }
-}
-
-void sort_unique(std::vector<Index>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 }  // namespace

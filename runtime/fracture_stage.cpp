@@ -9,6 +9,7 @@
 #include "fracture/strength_scatter.hpp"
 #include "kernels/error.hpp"
 #include "kernels/tet4.hpp"
+#include "runtime/sort_unique.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -131,8 +132,7 @@ void FractureStage::share(const Insertion& ins) {
   if (!dec_.distributed()) return;
   std::vector<Index> near;
   for (const Index n : ins.changed_nodes()) cohesive_around(n, near);
-  std::sort(near.begin(), near.end());
-  near.erase(std::unique(near.begin(), near.end()), near.end());
+  sort_unique(near);
   std::vector<char> is_near(cohesive_.size(), 0);
   for (const Index c : near) is_near[c] = 1;
   // The others kept, in order, with the near ones (older than the new ones) merged in.
@@ -165,8 +165,7 @@ std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const
 
 Insertion FractureStage::insert(std::span<const GlobalId> gids) {
   std::vector<GlobalId> sorted(gids.begin(), gids.end());
-  std::sort(sorted.begin(), sorted.end());
-  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  sort_unique(sorted);
   const std::vector<Index> held = facets(sorted);
   Insertion ins;
   ins.first_cohesive = cohesive_.size();
