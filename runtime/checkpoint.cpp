@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/comm_place.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/fnv1a.hpp"
 #include "runtime/first_failure.hpp"
@@ -140,14 +141,6 @@ std::uint64_t rows_hash(const void* data, std::size_t rows, std::size_t row_byte
   const auto* p = static_cast<const unsigned char*>(data);
   for (std::size_t i = 0; i < rows; ++i) h += row_hash(first + i, p + i * row_bytes, row_bytes);
   return h;
-}
-
-/// The ranks of `comm`, 1 without MPI (tests that write one rank's checkpoint).
-int ranks_of(MPI_Comm comm) {
-  int initialised = 0, ranks = 1;
-  MPI_Initialized(&initialised);
-  if (initialised) MPI_Comm_size(comm, &ranks);
-  return ranks;
 }
 
 /// Writes a checkpoint with every rank of `comm` (one rank: the whole
@@ -594,7 +587,7 @@ void write_checkpoint(const std::filesystem::path& path, const Model& model,
   const CheckpointRows every = given ? CheckpointRows{} : all_rows(model, s);
   const CheckpointRows& r = given ? *given : every;
   Writer w{tmp.string(), r.comm, 0, 1, {}};
-  w.ranks = ranks_of(r.comm);
+  w.ranks = comm_place(r.comm).size;
   if (w.ranks > 1) MPI_Comm_rank(r.comm, &w.rank);
   const QuietHdf5 quiet;
   const int k = model.mesh.nodes_per_element();

@@ -8,6 +8,7 @@
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
 #include "mesh/reorder.hpp"
+#include "runtime/comm_place.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
 #include "runtime/shell_model.hpp"
@@ -29,13 +30,10 @@ std::vector<Index> morton_positions(std::span<const Vec3> points) {
 }  // namespace
 
 Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) {
-  int initialised = 0;
-  MPI_Initialized(&initialised);
-  if (initialised) {
-    comm_ = comm;
-    MPI_Comm_rank(comm, &rank_);
-    MPI_Comm_size(comm, &size_);
-  }
+  const CommPlace place = comm_place(comm);
+  if (place.mpi) comm_ = comm;
+  rank_ = place.rank;
+  size_ = place.size;
   const Mesh& mesh = model.mesh;
   if (model.is_part()) {
     granule_rank_ = model.part.granule_rank;

@@ -1,15 +1,13 @@
 #include "runtime/first_failure.hpp"
 
+#include "runtime/comm_place.hpp"
+
 namespace shatter {
 
 std::string first_failure(const std::string& mine, MPI_Comm comm) {
-  int initialised = 0;
-  MPI_Initialized(&initialised);
-  if (!initialised) return mine;
-  int rank = 0, ranks = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &ranks);
-  if (ranks == 1) return mine;
+  const CommPlace place = comm_place(comm);
+  if (place.size == 1) return mine;
+  const int rank = place.rank, ranks = place.size;
   int failed = mine.empty() ? ranks : rank;
   MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MIN, comm);
   if (failed == ranks) return "";
