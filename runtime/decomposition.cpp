@@ -63,6 +63,12 @@ Decomposition::Decomposition(const Model& model, MPI_Comm comm) : model_(model) 
   for (Index e = 0; e < mesh.num_elements(); ++e)
     if (owns_element(e)) owned_element_ids_.push_back(e);
   owned_elements_ = static_cast<Index>(owned_element_ids_.size());
+  if (size_ > 1) {
+    std::vector<char> owner(size_, 0);
+    for (Index e = 0; e < mesh.num_elements(); ++e) owner[element_rank(e)] = 1;
+    for (int r = 0; r < size_; ++r)
+      if (owner[r] && r != rank_) neighbours_.push_back(r);
+  }
   rebuild_nodes();
 }
 
@@ -322,7 +328,27 @@ std::vector<double> Decomposition::allgather(std::span<const double> mine) const
   return allgather_of(mine, MPI_DOUBLE, comm_, size_);
 }
 
+std::vector<GlobalId> Decomposition::share_with_neighbours(std::span<const GlobalId> mine) const {
+  std::vector<GlobalId> out(mine.begin(), mine.end());
+  if (size_ == 1) return out;
+  std::vector<std::vector<GlobalId>> to(size_);
+  for (const int q : neighbours_) to[q] = out;
+  for (const std::vector<GlobalId>& from : alltoall(to)) out.insert(out.end(), from.begin(), from.end());
+  return out;
+}
+
 std::vector<std::vector<Index>> Decomposition::alltoall(const std::vector<std::vector<Index>>& to) const {
+  static_assert(sizeof(Index) == sizeof(int));
+  return alltoall_of(to, MPI_INT);
+}
+
+std::vector<std::vector<GlobalId>> Decomposition::alltoall(const std::vector<std::vector<GlobalId>>& to) const {
+  static_assert(sizeof(GlobalId) == sizeof(std::int64_t));
+  return alltoall_of(to, MPI_INT64_T);
+}
+
+template <class T>
+std::vector<std::vector<T>> Decomposition::alltoall_of(const std::vector<std::vector<T>>& to, MPI_Datatype type) const {
   SHATTER_REQUIRE(static_cast<int>(to.size()) == size_, "alltoall: " << to.size() << " lists for " << size_ << " ranks");
   if (size_ == 1) return to;
   std::vector<int> send_counts(size_), recv_counts(size_), send_at(size_, 0), recv_at(size_, 0);
@@ -332,13 +358,12 @@ std::vector<std::vector<Index>> Decomposition::alltoall(const std::vector<std::v
     send_at[r] = send_at[r - 1] + send_counts[r - 1];
     recv_at[r] = recv_at[r - 1] + recv_counts[r - 1];
   }
-  std::vector<Index> out, in(recv_at[size_ - 1] + recv_counts[size_ - 1]);
+  std::vector<T> out, in(recv_at[size_ - 1] + recv_counts[size_ - 1]);
   out.reserve(send_at[size_ - 1] + send_counts[size_ - 1]);
   for (const auto& list : to) out.insert(out.end(), list.begin(), list.end());
-  static_assert(sizeof(Index) == sizeof(int));
-  MPI_Alltoallv(out.data(), send_counts.data(), send_at.data(), MPI_INT, in.data(), recv_counts.data(),
-                recv_at.data(), MPI_INT, comm_);
-  std::vector<std::vector<Index>> from(size_);
+  MPI_Alltoallv(out.data(), send_counts.data(), send_at.data(), type, in.data(), recv_counts.data(),
+                recv_at.data(), type, comm_);
+  std::vector<std::vector<T>> from(size_);
   for (int r = 0; r < size_; ++r) from[r].assign(in.begin() + recv_at[r], in.begin() + recv_at[r] + recv_counts[r]);
   return from;
 }

@@ -172,9 +172,18 @@ class Decomposition {
   std::vector<Index> allgather(std::span<const Index> mine) const;
   std::vector<GlobalId> allgather(std::span<const GlobalId> mine) const;
   std::vector<double> allgather(std::span<const double> mine) const;
+  /// This rank's `mine` followed by the lists of the ranks around it (any
+  /// order): each rank sends its list to the ranks whose parts hold an
+  /// element it owns, which are the ranks owning an element of its part (the
+  /// ghost layers are rings of elements sharing nodes, so the relation is
+  /// symmetric). A list about facets of owned elements (critical, freed) thus
+  /// reaches every rank holding one of them, and no other; with the whole
+  /// model on every rank, every rank. Collective (alltoall).
+  std::vector<GlobalId> share_with_neighbours(std::span<const GlobalId> mine) const;
   /// Sparse all-to-all: to[r] goes to rank r (to.size() == size()); returns what each rank sent here
   /// (MPI_Alltoall of the counts, MPI_Alltoallv of the ids; collective).
   std::vector<std::vector<Index>> alltoall(const std::vector<std::vector<Index>>& to) const;
+  std::vector<std::vector<GlobalId>> alltoall(const std::vector<std::vector<GlobalId>>& to) const;
   /// Global minimum (exact in any order).
   double min(double value) const;
   /// In place: the element-wise global minima.
@@ -193,10 +202,14 @@ class Decomposition {
   std::vector<long> gather(long value) const;
 
  private:
+  template <class T>
+  std::vector<std::vector<T>> alltoall_of(const std::vector<std::vector<T>>& to, MPI_Datatype type) const;
+
   const Model& model_;
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0, size_ = 1;
   std::vector<int> granule_rank_;
+  std::vector<int> neighbours_;  ///< the other ranks owning an element held here, ascending
   /// The first granule of the shell nodes (kShellGranule shell nodes each,
   /// past the elements' granules; a shell node's home granule).
   Index first_shell_granule_ = 0;

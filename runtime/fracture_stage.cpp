@@ -163,19 +163,21 @@ std::vector<Index> FractureStage::check(std::span<const Vec3> x, std::span<const
                [&] { return critical_facets(model_.mesh, topology_, x, stress6, 6, laws(), local, owned); });
 }
 
-Insertion FractureStage::insert(std::span<const GlobalId> gids) {
-  std::vector<GlobalId> sorted(gids.begin(), gids.end());
-  sort_unique(sorted);
-  const std::vector<Index> held = facets(sorted);
+Insertion FractureStage::insert(std::span<const GlobalId> gids, const KeyPositions& whole) {
+  SHATTER_REQUIRE(whole.position.size() == gids.size(), "FractureStage::insert: " << whole.position.size()
+                                                            << " positions for " << gids.size() << " facets");
+  SHATTER_REQUIRE(std::is_sorted(gids.begin(), gids.end()), "FractureStage::insert: facet ids not ascending");
+  const std::vector<Index> held = facets(gids);
   Insertion ins;
   ins.first_cohesive = cohesive_.size();
   if (!held.empty()) ins = insert_cohesive_elements(model_.mesh, topology_, cohesive_, held);
-  // The whole model inserts the list in the order of the facet ids.
-  for (Index c = ins.first_cohesive; c < cohesive_.size(); ++c)
-    cohesive_whole_.push_back(whole_cohesive_ + static_cast<Index>(std::lower_bound(sorted.begin(), sorted.end(),
-                                                                                    topology_.facet_gid[cohesive_.facet[c]]) -
-                                                                   sorted.begin()));
-  whole_cohesive_ += static_cast<Index>(sorted.size());
+  // The whole model inserts its critical facets in the order of their ids.
+  for (Index c = ins.first_cohesive; c < cohesive_.size(); ++c) {
+    const auto at = std::lower_bound(gids.begin(), gids.end(), topology_.facet_gid[cohesive_.facet[c]]) - gids.begin();
+    SHATTER_REQUIRE(whole.position[at] >= 0, "FractureStage::insert: facet " << gids[at] << " was found by no rank");
+    cohesive_whole_.push_back(whole_cohesive_ + whole.position[at]);
+  }
+  whole_cohesive_ += whole.total;
   index_cohesive(ins.first_cohesive);
   return ins;
 }
@@ -234,13 +236,12 @@ std::vector<std::array<Index, 2>> FractureStage::bonded_twins() const {
   return twins;
 }
 
-Index FractureStage::release(std::span<const GlobalId> gids) {
+void FractureStage::release(std::span<const GlobalId> gids, Index freed) {
   const std::vector<Index> held = facets(gids);
   for (Index f : held) topology_.facet_state[f] = FacetState::free;
   released_ += static_cast<Index>(held.size());  // freed facets exert no force: the eigenvalue bound's key changes
   // (The fragments change on every rank, whichever facets it holds.)
-  if (!gids.empty()) ++facet_revision_;
-  return static_cast<Index>(gids.size());
+  if (freed > 0) ++facet_revision_;
 }
 
 long FractureStage::across_ranks() const {

@@ -14,6 +14,7 @@
 #include "fracture/cohesive_elements.hpp"
 #include "fracture/fragments.hpp"
 #include "runtime/decomposition.hpp"
+#include "runtime/key_positions.hpp"
 #include "runtime/fragment_labels.hpp"
 #include "runtime/model.hpp"
 
@@ -133,11 +134,13 @@ class FractureStage {
   /// and `owned` elements, empty on one rank).
   std::vector<Index> check(std::span<const Vec3> x, std::span<const double> stress6,
                            std::span<const Index> local = {}, std::span<const Index> owned = {});
-  /// The facets of `gids` (every rank's critical facets, by global id, the
-  /// same list on every rank) that are held here become cohesive elements
-  /// (in canonical order, whatever the order given); nodes split. Returns
-  /// what changed here (new nodes to fill in by the caller).
-  Insertion insert(std::span<const GlobalId> gids);
+  /// The facets of `gids` (critical facets by global id, ascending and
+  /// distinct: at least every one held here) that are held here become
+  /// cohesive elements, in the order of their ids; nodes split. `whole`:
+  /// each gid's position among the whole model's critical facets and their
+  /// count (key_positions), which number the cohesive elements as one rank
+  /// would. Returns what changed here (new nodes to fill in by the caller).
+  Insertion insert(std::span<const GlobalId> gids, const KeyPositions& whole);
   const Topology& topology() const { return topology_; }
   /// Both faces (element, local face) of every cohesive facet not yet freed, ascending.
   std::vector<std::pair<Index, int>> bonded_faces() const;
@@ -157,9 +160,10 @@ class FractureStage {
   /// The facets among those owned here that are fully debonded and not in
   /// compression at positions x (debonded_facets), to free on every rank.
   std::vector<Index> debonded(std::span<const Vec3> x) const;
-  /// Frees the facets of `gids` held here (every rank's debonded(), by global
-  /// id, the same list everywhere); returns how many the whole model freed.
-  Index release(std::span<const GlobalId> gids);
+  /// Frees the facets of `gids` held here (debonded() of this rank and of the
+  /// ranks around, by global id: at least every one held here); `freed`: how
+  /// many the whole model frees.
+  void release(std::span<const GlobalId> gids, Index freed);
   /// The cohesive elements of `mine`, a state saved here (save()) since the
   /// last insertion or earlier, that this rank owns and writes to a
   /// checkpoint (those whose facet's first element it owns), as indices into

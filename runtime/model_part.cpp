@@ -12,6 +12,7 @@
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/element_forces.hpp"
+#include "runtime/key_positions.hpp"
 #include "runtime/loads.hpp"
 
 namespace shatter {
@@ -219,27 +220,30 @@ Index number_split_nodes(Model& m, Index first, std::uint64_t revision, const De
   };
   // Names, doubled, plus one for a copy with a prescribed component.
   auto key = [&](Index n) { return 2 * mesh.node_gid[n] + (m.bc_mask[n] ? 1 : 0); };
-  std::vector<GlobalId> mine;
-  for (Index n = first; n < nn; ++n)
-    if (owner(n) == dec.rank()) mine.push_back(key(n));
-  std::vector<GlobalId> all = dec.allgather(std::span<const GlobalId>(mine));
-  std::sort(all.begin(), all.end());
-  std::vector<GlobalId> held;  // the prescribed ones
-  for (GlobalId g : all)
-    if (g & 1) held.push_back(g);
+  // Every rank names the copies it holds; each is numbered by its owner's name.
+  std::vector<GlobalId> mine, names, mine_held, names_held;  // (held: the prescribed ones)
   for (Index n = first; n < nn; ++n) {
-    const auto it = std::lower_bound(all.begin(), all.end(), key(n));
-    const bool named = it != all.end() && *it == key(n);
-    part.node_index.push_back(named ? part.whole_nodes + static_cast<Index>(it - all.begin()) : -1);
+    const bool owned = owner(n) == dec.rank();
+    names.push_back(key(n));
+    if (owned) mine.push_back(key(n));
     if (!m.bc_mask[n]) continue;
-    part.bc_index.push_back(named ? part.whole_bc_nodes + static_cast<Index>(std::lower_bound(held.begin(), held.end(), key(n)) - held.begin())
-                                  : -1);
+    names_held.push_back(key(n));
+    if (owned) mine_held.push_back(key(n));
   }
-  part.whole_nodes += static_cast<Index>(all.size());
-  part.whole_bc_nodes += static_cast<Index>(held.size());
+  const KeyPositions all = key_positions(mine, names, dec), held = key_positions(mine_held, names_held, dec);
+  size_t h = 0;
+  for (Index n = first; n < nn; ++n) {
+    const Index k = all.position[n - first];
+    part.node_index.push_back(k >= 0 ? part.whole_nodes + k : -1);
+    if (!m.bc_mask[n]) continue;
+    const Index b = held.position[h++];
+    part.bc_index.push_back(k >= 0 ? part.whole_bc_nodes + b : -1);
+  }
+  part.whole_nodes += all.total;
+  part.whole_bc_nodes += held.total;
   // (The outer layer may have split alone: the whole model's revision, as fields.h5 writes it.)
-  mesh.revision = revision + (all.empty() ? 0 : 1);
-  return static_cast<Index>(all.size());
+  mesh.revision = revision + (all.total == 0 ? 0 : 1);
+  return all.total;
 }
 
 void distribute_parts(Model& model, MPI_Comm comm) {

@@ -13,11 +13,13 @@
 #include "runtime/diagnosis.hpp"
 #include "runtime/field_output.hpp"
 #include "runtime/fracture_stage.hpp"
+#include "runtime/key_positions.hpp"
 #include "runtime/model_part.hpp"
 #include "runtime/loads.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/report.hpp"
 #include "runtime/rigid_bodies.hpp"
+#include "runtime/sort_unique.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -311,20 +313,34 @@ void Simulation::correct(const std::vector<Vec3>& reaction_old) {
 void Simulation::apply_fracture() {
   // A cohesive element is freed by its owner, which computes it; a facet is
   // checked by the owner of its smaller element, which holds both elements'
-  // stresses. Every rank frees and inserts the gathered lists (by facet
-  // global id) where it holds the facets.
-  const Index freed = fracture_->release(dec_->allgather(fracture_->gids(fracture_->debonded(x_))));
-  const std::vector<GlobalId> critical =
-      dec_->distributed()
-          ? dec_->allgather(fracture_->gids(
-                fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids())))
-          : fracture_->gids(fracture_->check(x_, stress6_));
+  // stresses. Each sends its lists (by facet global id) to the ranks around
+  // it, every one of which frees and inserts the facets it holds; the
+  // cohesive elements are numbered by their positions among all the ranks'
+  // critical facets (key_positions), with no list of the whole model's.
+  const std::vector<GlobalId> debonded = fracture_->gids(fracture_->debonded(x_));
+  Index freed = 0;
+  std::vector<GlobalId> freed_here;
+  timed(comm_seconds_, [&] {
+    freed = static_cast<Index>(dec_->sum(std::vector<long>{static_cast<long>(debonded.size())})[0]);
+    freed_here = dec_->share_with_neighbours(debonded);
+  });
+  fracture_->release(freed_here, freed);
+  const std::vector<GlobalId> found =
+      fracture_->gids(dec_->distributed() ? fracture_->check(x_, stress6_, dec_->local_elements(), dec_->owned_element_ids())
+                                          : fracture_->check(x_, stress6_));
+  std::vector<GlobalId> critical;
+  KeyPositions numbers;
+  timed(comm_seconds_, [&] {
+    critical = dec_->share_with_neighbours(found);
+    sort_unique(critical);
+    numbers = key_positions(found, critical, *dec_);
+  });
   const Index before = fracture_->cohesive_count();
   // Insertion is timed without the gather of the new nodes' names (communication).
   Insertion ins;
   const std::uint64_t revision = model_.mesh.revision;
   timed(insert_seconds_, insert_cpu_seconds_, [&] {
-    ins = fracture_->insert(critical);
+    ins = fracture_->insert(critical, numbers);
     if (!ins.new_nodes.empty()) grow_nodes(ins.new_nodes);
   });
   ledger_.cohesive_elements = fracture_->cohesive_count();

@@ -17,6 +17,7 @@
 #include "runtime/element_forces.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/fragment_labels.hpp"
+#include "runtime/key_positions.hpp"
 #include "runtime/model_part.hpp"
 #include "runtime/model.hpp"
 #include "runtime/row_blocks.hpp"
@@ -129,6 +130,43 @@ TEST(Decomposition, GhostUpdateAndRowBlocksDeliverTheOwnersValues) {
   const std::vector<Index> all = d.allgather(mine);
   ASSERT_EQ(static_cast<int>(all.size()), d.size() * (d.size() + 1) / 2);
   for (size_t i = 1; i < all.size(); ++i) EXPECT_LE(all[i - 1], all[i]);
+}
+
+TEST(Decomposition, KeyPositionsAreThoseInTheSortedUnion) {
+  // Each rank contributes a scattered set of keys, some also contributed by
+  // another rank, and asks for some of its own, some of others' and some
+  // that nobody contributed; a sort of the whole union (every rank can make
+  // it here) gives the expected positions.
+  const Model& m = box();
+  Decomposition d(m, MPI_COMM_WORLD);
+  auto contributed_by = [](int r) {
+    std::vector<GlobalId> keys;
+    for (GlobalId k = 0; k < 400; ++k)
+      if ((k * 7919 + r * 31) % 5 == 0 || k % 97 == r) keys.push_back(1000003 * (k % 13) + 3 * k + (k % 2));
+    return keys;
+  };
+  std::vector<GlobalId> whole;
+  for (int r = 0; r < d.size(); ++r) {
+    const std::vector<GlobalId> keys = contributed_by(r);
+    whole.insert(whole.end(), keys.begin(), keys.end());
+  }
+  std::sort(whole.begin(), whole.end());
+  whole.erase(std::unique(whole.begin(), whole.end()), whole.end());
+  const std::vector<GlobalId> mine = contributed_by(d.rank());
+  std::vector<GlobalId> queried(mine.rbegin(), mine.rend());
+  for (GlobalId k = 0; k < 200; ++k) queried.push_back(1000003 * (k % 17) + 5 * k + d.rank());
+  const KeyPositions p = key_positions(mine, queried, d);
+  EXPECT_EQ(p.total, static_cast<Index>(whole.size()));
+  ASSERT_EQ(p.position.size(), queried.size());
+  for (size_t q = 0; q < queried.size(); ++q) {
+    const auto it = std::lower_bound(whole.begin(), whole.end(), queried[q]);
+    const Index expected = it != whole.end() && *it == queried[q] ? static_cast<Index>(it - whole.begin()) : -1;
+    EXPECT_EQ(p.position[q], expected) << "key " << queried[q];
+  }
+  // No key anywhere: nothing is named.
+  const KeyPositions none = key_positions({}, queried, d);
+  EXPECT_EQ(none.total, 0);
+  EXPECT_EQ(std::count(none.position.begin(), none.position.end(), -1), static_cast<long>(queried.size()));
 }
 
 TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
@@ -302,10 +340,11 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
       if (wt.is_interior(f) && wt.facet_state[f] == FacetState::intact &&
           (static_cast<std::uint64_t>(wt.facet_gid[f]) * 2654435761u + round) % 100 < 12)
         gids.push_back(wt.facet_gid[f]);
-    on_whole.insert(gids);
+    std::sort(gids.begin(), gids.end());
+    on_whole.insert(gids, key_positions(gids, gids, one));
     const std::uint64_t revision = part.mesh.revision;
     const Index before = part.mesh.num_nodes();
-    on_part.insert(gids);
+    on_part.insert(gids, key_positions(gids, gids, d));
     part.bc_mask.resize(part.mesh.num_nodes(), 0);  // (no condition: the copies hold nothing)
     if (part.holds_two_layers()) {
       const Index added = number_split_nodes(part, before, revision, d);
@@ -428,7 +467,7 @@ TEST(Decomposition, UpdateAfterInsertionEqualsRebuild) {
     gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
     const std::uint64_t revision = part.mesh.revision;
     const Index before = part.mesh.num_nodes();
-    const Insertion ins = stage.insert(gids);
+    const Insertion ins = stage.insert(gids, key_positions(gids, gids, updated));
     split += static_cast<long>(ins.new_nodes.size());
     part.bc_mask.resize(part.mesh.num_nodes(), 0);
     if (part.holds_two_layers()) number_split_nodes(part, before, revision, updated);
