@@ -6,6 +6,8 @@
 #include <numeric>
 
 #include "runtime/halo.hpp"
+#include "runtime/key_positions.hpp"
+#include "runtime/sort_unique.hpp"
 
 namespace shatter {
 
@@ -85,19 +87,22 @@ Fragments FragmentLabels::label(const Topology& topo) const {
     for (Index e : owned_) label[e] = root_label[find_root(parent, e)];
   }
   // A fragment's label is the global id of its smallest element, which one
-  // rank owns: the fragments are numbered by those ids, gathered.
-  std::vector<GlobalId> mine;
+  // rank owns: the fragments are numbered by the positions of those ids
+  // among all the ranks' (key_positions, no list of every fragment).
+  std::vector<GlobalId> mine, seen;
   for (Index e : owned_)
     if (label[e] == static_cast<double>(mesh.elem_gid[e])) mine.push_back(mesh.elem_gid[e]);
-  std::vector<GlobalId> all = dec_.allgather(mine);
-  std::sort(all.begin(), all.end());
+  for (Index e = 0; e < ne; ++e)
+    if (label[e] != kNone) seen.push_back(static_cast<GlobalId>(label[e]));
+  sort_unique(seen);
+  const KeyPositions numbers = key_positions(mine, seen, dec_);
   Fragments out;
-  out.fragments = static_cast<Index>(all.size());
+  out.fragments = numbers.total;
   out.elem_fragment.assign(ne, -1);
   for (Index e = 0; e < ne; ++e)
     if (label[e] != kNone)
       out.elem_fragment[e] =
-          static_cast<Index>(std::lower_bound(all.begin(), all.end(), static_cast<GlobalId>(label[e])) - all.begin());
+          numbers.position[std::lower_bound(seen.begin(), seen.end(), static_cast<GlobalId>(label[e])) - seen.begin()];
   return out;
 }
 
