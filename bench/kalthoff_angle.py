@@ -10,13 +10,13 @@ centre line at y = 25 mm, 1.5 mm wide; the symmetry plane is y = 0.
 Criterion. In the last field frame (fields.h5, read with
 scripts/crack_frames.py), the crack is the set of fully open elements (damage
 1) connected to the notch tip through fully open elements whose centroids are
-at most 1.5 H apart (H = element size, default 2 mm); its root is the fully
-open elements whose centroids lie within 1.5 H of the tip's end face (x = 50
-mm, |y - 25 mm| <= 0.75 mm). The angle is that of the line fitted through
-the crack's centroids (least squares on the perpendicular distances: the
-principal axis of the centroids), pointed away from the tip, against the
-notch direction +x, in degrees (positive toward +y, away from the symmetry
-plane). The damage field is per element (the largest of its facets), so
+at most 1.5 H apart (H = element size, default 1 mm: the scene's); its root
+is the fully open elements whose centroids lie within 1.5 H of the tip's end
+face (x = 50 mm, |y - 25 mm| <= 0.75 mm). The angle is that of the line
+fitted through the crack's centroids (least squares on the perpendicular
+distances: the principal axis of the centroids), pointed away from the tip,
+against the notch direction +x, in degrees (positive toward +y, away from
+the symmetry plane). The damage field is per element (the largest of its facets), so
 the centroids are those of the elements next to the opened facets, half an
 element off the crack faces at most.
 
@@ -91,7 +91,7 @@ def draw(out, X, c, d, crack, u, mean, angle, t):
 def main(argv):
     csv = "--csv" in argv
     argv = [a for a in argv if a != "--csv"]
-    opts = {"--h": "2.0e-3", "--png": None}
+    opts = {"--h": "1.0e-3", "--png": None}
     for k in opts:
         if k in argv:
             i = argv.index(k)
