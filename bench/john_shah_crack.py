@@ -34,33 +34,21 @@ when neither crack runs by the last frame (run longer); exit 4 when both
 reach the height in the same frame (undecided at this output interval);
 exit 2 on a missing or unreadable run. Reads RUN_DIR/fields.h5 and, after a
 restart, the frames of RUN_DIR/restart_*/fields.h5.
-Needs python3-h5py and python3-numpy (scripts/install-deps.sh).
+Needs python3-h5py and python3-numpy (scripts/install-deps.sh); reads the
+frames with scripts/crack_frames.py.
 """
-import glob
+import os
 import sys
 
-import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+from crack_frames import FULL, connected, field_paths, frames  # noqa: E402
 
 DEPTH = 0.0762
 HALF_SPAN = 0.1016
 NOTCH_DEPTH = DEPTH / 4
 NOTCH_HALF_WIDTH = 0.0015
-FULL = 1.0 - 1e-9
-
-
-def frames(paths):
-    """(time, centroids, damage) of every frame of the files, by time, each time once."""
-    out = {}
-    for p in paths:
-        with h5py.File(p, "r") as f:
-            for k in (k for k in f.keys() if k.startswith("step_")):
-                g = f[k]
-                mesh = f["mesh"][str(int(g.attrs["mesh"]))]
-                X = mesh["coordinates"][()]
-                T = mesh["topology"][()][:, :4]
-                out[float(g.attrs["time"])] = (X[T].mean(axis=1), g["damage"][()])
-    return [(t, c, d) for t, (c, d) in sorted(out.items())]
 
 
 def crack_height(c, d, region, root, base, h):
@@ -69,15 +57,9 @@ def crack_height(c, d, region, root, base, h):
     pts = c[open_]
     if len(pts) == 0:
         return 0.0, False
-    reached = root[open_].copy()
+    reached = connected(pts, root[open_], 1.5 * h)
     if not reached.any():
         return 0.0, True
-    near = np.linalg.norm(pts[:, None, :2] - pts[None, :, :2], axis=2) <= 1.5 * h
-    while True:
-        grown = reached | near[reached].any(axis=0)
-        if (grown == reached).all():
-            break
-        reached = grown
     return max(0.0, pts[reached, 1].max() - base), True
 
 
@@ -92,9 +74,8 @@ def main(argv):
     if len(argv) != 3:
         sys.exit(__doc__)
     run, gamma = argv[1], float(argv[2])
-    paths = [f"{run}/fields.h5"] + sorted(glob.glob(f"{run}/restart_*/fields.h5"))
     try:
-        fr = frames(paths)
+        fr = frames(field_paths(run))
     except (OSError, KeyError) as e:
         print(f"john_shah_crack: {run}: cannot read the damage frames: {e}", file=sys.stderr)
         return 2
@@ -105,7 +86,7 @@ def main(argv):
     t_run = {}
     first_full = {}
     height = {}
-    for t, c, d in fr:
+    for t, _, c, d in fr:
         x, y = c[:, 0], c[:, 1]
         regions = {
             "notch": ((np.abs(x - xn) <= 0.020) & (y <= 0.050),
