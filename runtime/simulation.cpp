@@ -164,7 +164,8 @@ void Simulation::compute_forces(long step, double time, const std::function<void
       a_[i] = inv_mass_[i] * (f_ext_[i] - f_int_[i]);
     }
   }
-  // Prescribed components: no acceleration; the reaction is the force that holds them.
+  // Prescribed components: no acceleration; the reaction here is the force that holds them
+  // against the others (its inertial part, m a, is booked by its work in correct()).
   for (size_t b = 0; b < bc_nodes_.size(); ++b) {
     const Index i = bc_nodes_[b];
     for (int c = 0; c < 3; ++c)
@@ -182,6 +183,8 @@ void Simulation::step() {
   if (opt_.before_step) opt_.before_step(step_ + 1);
   dt_ = next_dt();
   const std::vector<Vec3> reaction_old = reaction_;
+  bc_v_old_.resize(bc_nodes_.size());
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_v_old_[b] = v_[bc_nodes_[b]];
   predict();
   if (contact_) resolve_contact();
   // The ghost-only positions travel while the elements that do not read them
@@ -304,10 +307,18 @@ void Simulation::book_contact_work() {
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
   half_kick(false);
   if (rigid_) rigid_->correct(dt_, x_, v_);
-  // The reactions' work by the trapezoidal rule, W += (R(n) + R(n+1))/2 . dx.
-  for (size_t b = 0; b < bc_nodes_.size(); ++b)
-    if (dec_->owns_node(bc_nodes_[b]))
-      step_work_[kReactionWork] += 0.5 * (reaction_old[b] + reaction_[b]).dot(bc_dx_[b]);
+  // The reactions' work. Their part f_int - f_ext (reaction_) by the
+  // trapezoidal rule, W += (R(n) + R(n+1))/2 . dx; their inertial part m a,
+  // which changes the prescribed components' velocities, did exactly the
+  // change of those components' kinetic energy, 1/2 m (v(n+1)^2 - v(n)^2).
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) {
+    const Index i = bc_nodes_[b];
+    if (!dec_->owns_node(i)) continue;
+    step_work_[kReactionWork] += 0.5 * (reaction_old[b] + reaction_[b]).dot(bc_dx_[b]);
+    for (int c = 0; c < 3; ++c)
+      if (model_.bc_mask[i] & (1u << c))
+        step_work_[kReactionWork] += 0.5 * model_.mass[i] * (v_[i][c] * v_[i][c] - bc_v_old_[b][c] * bc_v_old_[b][c]);
+  }
 }
 
 void Simulation::apply_fracture() {

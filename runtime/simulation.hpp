@@ -232,6 +232,7 @@ class Simulation {
   std::vector<Index> bc_nodes_;        ///< nodes with a prescribed component
   std::vector<Vec3> reaction_;         ///< per bc node: reaction force at the last evaluation, N
   std::vector<Vec3> bc_dx_;            ///< per bc node: its displacement over the step under way, m
+  std::vector<Vec3> bc_v_old_;         ///< per bc node: its velocity at the start of the step under way, m/s
   std::vector<double> bc_factor_;      ///< per boundary condition: its values' factor at the half step under way
   std::unique_ptr<SurfaceLoads> loads_;  ///< null without loads
   std::unique_ptr<RigidBodies> rigid_;   ///< null without free rigid bodies

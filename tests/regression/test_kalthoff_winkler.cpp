@@ -33,11 +33,12 @@ using namespace shatter;
 // measured 65-77 degrees once the crack was 6 mm long (73.7 at 60 us), h = 1.5 mm
 // 70.4 and h = 1 mm 66.1. A shear crack along the notch (0 degrees), one toward the
 // symmetry plane (negative) or straight across (90) fails it. The ledger's energy
-// error stays under 1 % from 10 us on (measured at most 4.7e-3, at 10 us; 7.8e-4 at
-// 60 us). Not before: the reactions leave out the inertia of the struck nodes
-// themselves (runtime/simulation.cpp: R = f_int - f_ext), so the ledger's total
-// gains their kinetic energy, 1/2 m v^2 = 0.096 J on this mesh, while the edge
-// speeds up: most of the little energy put in during the first microsecond
+// error stays under 1e-3 until the first facet opens, while the struck edge
+// speeds up (measured at most 1.3e-4, in the first steps, when the energy put in
+// is still tiny; 1e-9 at 20 us): the reactions' work includes that of their
+// inertial part, the struck nodes' own kinetic energy (without it the error
+// reached 1.0 in the first steps and 0.42 at 0.4 us), and under 1 % after it
+// (the cohesive law's chatter, docs/physics.md; measured at most 4.7e-3)
 // (docs/validation.md "Kalthoff-Winkler").
 TEST(Scenes, KalthoffWinklerCrackLeavesTheNotchTipAtTheHoopStressAngle) {
   const std::string path = std::string(SHATTER_SOURCE_DIR) + "/scenes/kalthoff_winkler.yaml";
@@ -50,10 +51,12 @@ TEST(Scenes, KalthoffWinklerCrackLeavesTheNotchTipAtTheHoopStressAngle) {
   opt.out_dir = out;
   opt.quiet = true;
   const Simulation* running = nullptr;
-  double max_energy_error = 0;
+  double max_energy_error = 0, max_intact_error = 0;
   std::vector<Vec3> first_damaged;  // reference centroids of the first elements with damage
   opt.before_step = [&](long) {
-    if (running->time() >= 10e-6) max_energy_error = std::max(max_energy_error, std::abs(running->energy_error()));
+    max_energy_error = std::max(max_energy_error, std::abs(running->energy_error()));
+    if (running->ledger().cohesive_elements == 0)
+      max_intact_error = std::max(max_intact_error, std::abs(running->energy_error()));
     if (!first_damaged.empty() || running->ledger().cohesive_elements == 0) return;
     const std::vector<double> damage = running->fracture()->damage();
     for (Index e = 0; e < model.mesh.num_elements(); ++e) {
@@ -67,6 +70,7 @@ TEST(Scenes, KalthoffWinklerCrackLeavesTheNotchTipAtTheHoopStressAngle) {
   running = &sim;
   sim.run();
   max_energy_error = std::max(max_energy_error, std::abs(sim.energy_error()));
+  EXPECT_LT(max_intact_error, 1e-3);
   EXPECT_LT(max_energy_error, 0.01);
   ASSERT_FALSE(first_damaged.empty()) << "no facet opened by " << sim.time() << " s";
   EXPECT_GT(sim.time(), 20e-6);
