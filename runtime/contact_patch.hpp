@@ -55,7 +55,7 @@ class ContactPatch {
   void own(std::span<const Index> primitives);
   bool owned_any() const { return owned_once_; }
   /// Whether this rank owns primitive q (numbered as in own()).
-  bool owns(Index q) const;
+  bool owns(Index q) const { return owned_mark_[q] != 0; }
   /// The triangles and edges owned here (surface indices, ascending) and their nodes.
   std::span<const Index> owned_triangles() const { return owned_triangles_; }
   std::span<const Index> owned_edges() const { return owned_edges_; }
@@ -103,6 +103,10 @@ class ContactPatch {
   /// and the nodes `receive` takes from each.
   void find_readers(const std::map<int, std::vector<Index>>& send, const std::map<int, std::vector<Index>>& receive);
   Halo* halo(PatchPlan plan) const;
+  /// Appends node n to `nodes` unless marked, and marks it.
+  void add_node(Index n, std::vector<Index>& nodes);
+  /// Clears the marks of `nodes` (from add_node) and sorts them.
+  void sort_marked(std::vector<Index>& nodes);
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
@@ -111,9 +115,10 @@ class ContactPatch {
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
   bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;
+  std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
   ContactSurface owned_, patch_;
   std::vector<Index> normal_triangles_;
-  std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach(), 0 between calls
+  std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach() and activate(), 0 between calls
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one

@@ -154,6 +154,7 @@ class ContactStage {
   const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
+  std::vector<Index> edge_offsets_;   ///< on ranks: surface_.edges from vertex k's on (CSR by first node)
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
@@ -175,7 +176,6 @@ class ContactStage {
   std::unique_ptr<ContactPartition> partition_;
   std::unique_ptr<ContactPatch> patch_;  ///< of surface_
   std::unique_ptr<PatchRanks> ranks_;    ///< DCR's exchanges between the patches
-  std::vector<Index> triangle_order_;    ///< triangles sorted by their nodes (pair -> face)
   std::vector<float> weight_;            ///< per triangle, then edge: candidates at the last search (owned ones)
   bool repartition_ = true;              ///< partition at the next search
 };
