@@ -43,7 +43,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
-from crack_frames import FULL, connected, field_paths, frames  # noqa: E402
+from crack_frames import FULL, connected, run_frames  # noqa: E402
 
 DEPTH = 0.0762
 HALF_SPAN = 0.1016
@@ -74,14 +74,7 @@ def main(argv):
     if len(argv) != 3:
         sys.exit(__doc__)
     run, gamma = argv[1], float(argv[2])
-    try:
-        fr = frames(field_paths(run))
-    except (OSError, KeyError) as e:
-        print(f"john_shah_crack: {run}: cannot read the damage frames: {e}", file=sys.stderr)
-        return 2
-    if not fr:
-        print(f"john_shah_crack: {run}: no field frames", file=sys.stderr)
-        return 2
+    fr = run_frames(run, "john_shah_crack")
     xn = gamma * HALF_SPAN
     t_run = {}
     first_full = {}

@@ -33,7 +33,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
-from crack_frames import FULL, connected, field_paths, frames  # noqa: E402
+from crack_frames import FULL, connected, run_frames  # noqa: E402
 
 TIP = np.array([0.050, 0.025])
 NOTCH_HALF_WIDTH = 0.75e-3
@@ -100,14 +100,7 @@ def main(argv):
     if len(argv) != 2:
         sys.exit(__doc__)
     run, h = argv[1], float(opts["--h"])
-    try:
-        fr = frames(field_paths(run))
-    except (OSError, KeyError) as e:
-        print(f"kalthoff_angle: {run}: cannot read the damage frames: {e}", file=sys.stderr)
-        return 2
-    if not fr:
-        print(f"kalthoff_angle: {run}: no field frames", file=sys.stderr)
-        return 2
+    fr = run_frames(run, "kalthoff_angle")
     t, X, c, d = fr[-1]
     crack = crack_from_tip(c, d, h)
     if len(crack) < 3:

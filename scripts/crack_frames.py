@@ -7,6 +7,7 @@ damage is 1 (a facet with no traction left: free crack faces).
 Needs python3-h5py and python3-numpy (scripts/install-deps.sh).
 """
 import glob
+import sys
 
 import h5py
 import numpy as np
@@ -35,6 +36,19 @@ def frames(paths):
                 T = mesh["topology"][()][:, :4]
                 out[float(g.attrs["time"])] = (X, X[T].mean(axis=1), g["damage"][()])
     return [(t, X, c, d) for t, (X, c, d) in sorted(out.items())]
+
+
+def run_frames(run, tool):
+    """frames() of a run folder; a missing or empty file is a message naming `tool` and exit 2."""
+    try:
+        fr = frames(field_paths(run))
+    except (OSError, KeyError) as e:
+        print(f"{tool}: {run}: cannot read the damage frames: {e}", file=sys.stderr)
+        sys.exit(2)
+    if not fr:
+        print(f"{tool}: {run}: no field frames", file=sys.stderr)
+        sys.exit(2)
+    return fr
 
 
 def connected(pts, root, reach):
