@@ -158,7 +158,8 @@ class FractureStage {
   double eigenvalue_bound(std::span<const double> mass);
 
   /// The facets among those owned here that are fully debonded and not in
-  /// compression at positions x (debonded_facets), to free on every rank.
+  /// compression at positions x (debonded_facets), to free on the ranks
+  /// holding them (Decomposition::share_with_neighbours).
   std::vector<Index> debonded(std::span<const Vec3> x) const;
   /// Frees the facets of `gids` held here (debonded() of this rank and of the
   /// ranks around, by global id: at least every one held here); `freed`: how
