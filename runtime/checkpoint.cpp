@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "kernels/error.hpp"
+#include "runtime/alltoall_lists.hpp"
 #include "runtime/comm_place.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/fnv1a.hpp"
@@ -515,23 +516,17 @@ void write_facets(const Writer& w, hid_t group, std::vector<std::pair<GlobalId, 
   std::sort(mine.begin(), mine.end());
   if (w.ranks > 1) {
     // (gid, state) as gid * 4 + state: one int64.
-    std::vector<std::int64_t> send;
-    std::vector<int> send_count(w.ranks, 0), recv_count(w.ranks, 0);
-    for (int d = 0, k = 0; d < w.ranks; ++d) {
+    std::vector<std::vector<std::int64_t>> to(w.ranks);
+    size_t sent = 0;
+    for (int d = 0; d < w.ranks; ++d) {
       const GlobalId end = gid_end * (d + 1) / w.ranks;
-      for (; k < static_cast<int>(mine.size()) && mine[k].first / 4 < end; ++k, ++send_count[d])
-        send.push_back(mine[k].first * 4 + static_cast<std::int64_t>(mine[k].second));
+      for (; sent < mine.size() && mine[sent].first / 4 < end; ++sent)
+        to[d].push_back(mine[sent].first * 4 + static_cast<std::int64_t>(mine[sent].second));
     }
-    SHATTER_REQUIRE(send.size() == mine.size(), "checkpoint: a facet of an element global id past " << gid_end);
-    MPI_Alltoall(send_count.data(), 1, MPI_INT, recv_count.data(), 1, MPI_INT, w.comm);
-    std::vector<int> send_at(w.ranks, 0), recv_at(w.ranks, 0);
-    for (int d = 1; d < w.ranks; ++d) {
-      send_at[d] = send_at[d - 1] + send_count[d - 1];
-      recv_at[d] = recv_at[d - 1] + recv_count[d - 1];
-    }
-    std::vector<std::int64_t> received(static_cast<size_t>(recv_at[w.ranks - 1] + recv_count[w.ranks - 1]));
-    MPI_Alltoallv(send.data(), send_count.data(), send_at.data(), MPI_INT64_T, received.data(), recv_count.data(),
-                  recv_at.data(), MPI_INT64_T, w.comm);
+    SHATTER_REQUIRE(sent == mine.size(), "checkpoint: a facet of an element global id past " << gid_end);
+    std::vector<std::int64_t> received;
+    for (const std::vector<std::int64_t>& from : alltoall_lists(to, MPI_INT64_T, w.comm))
+      received.insert(received.end(), from.begin(), from.end());
     std::sort(received.begin(), received.end());
     mine.clear();
     for (std::int64_t r : received) mine.emplace_back(r / 4, static_cast<FacetState>(r % 4));

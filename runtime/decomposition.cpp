@@ -8,6 +8,7 @@
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
 #include "mesh/reorder.hpp"
+#include "runtime/alltoall_lists.hpp"
 #include "runtime/comm_place.hpp"
 #include "runtime/global_sum.hpp"
 #include "runtime/halo.hpp"
@@ -351,21 +352,7 @@ template <class T>
 std::vector<std::vector<T>> Decomposition::alltoall_of(const std::vector<std::vector<T>>& to, MPI_Datatype type) const {
   SHATTER_REQUIRE(static_cast<int>(to.size()) == size_, "alltoall: " << to.size() << " lists for " << size_ << " ranks");
   if (size_ == 1) return to;
-  std::vector<int> send_counts(size_), recv_counts(size_), send_at(size_, 0), recv_at(size_, 0);
-  for (int r = 0; r < size_; ++r) send_counts[r] = static_cast<int>(to[r].size());
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
-  for (int r = 1; r < size_; ++r) {
-    send_at[r] = send_at[r - 1] + send_counts[r - 1];
-    recv_at[r] = recv_at[r - 1] + recv_counts[r - 1];
-  }
-  std::vector<T> out, in(recv_at[size_ - 1] + recv_counts[size_ - 1]);
-  out.reserve(send_at[size_ - 1] + send_counts[size_ - 1]);
-  for (const auto& list : to) out.insert(out.end(), list.begin(), list.end());
-  MPI_Alltoallv(out.data(), send_counts.data(), send_at.data(), type, in.data(), recv_counts.data(),
-                recv_at.data(), type, comm_);
-  std::vector<std::vector<T>> from(size_);
-  for (int r = 0; r < size_; ++r) from[r].assign(in.begin() + recv_at[r], in.begin() + recv_at[r] + recv_counts[r]);
-  return from;
+  return alltoall_lists(to, type, comm_);
 }
 
 std::vector<GlobalId> Decomposition::allgather(std::span<const GlobalId> mine) const {
