@@ -11,6 +11,9 @@
 //
 // The surface's topology (triangles, edges, the vertex -> triangle lists) is
 // still held on every rank: memory that grows with the surface, no traffic.
+// Between ranks, nodes are named by their whole-model ids and edges by their
+// two nodes' (docs/parallel.md "Patches with their own topology", step 1),
+// never by positions in the replicated surface.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -25,6 +28,7 @@ namespace shatter {
 
 class Decomposition;
 class Halo;
+struct Model;
 
 /// Swept boxes of a surface's primitives from x_old to x_new (swept_boxes), each grown by
 /// 1.01 margin on every side: the boxes of a search whose candidates serve while every node
@@ -41,10 +45,10 @@ enum class PatchPlan { Owned, Patch, Active };
 class ContactPatch {
  public:
   /// surface, around: the contact surface and its vertex -> triangle lists, held by the
-  /// caller for the patch's lifetime (a new surface needs a new patch); num_nodes: the
-  /// length of the nodal arrays.
+  /// caller for the patch's lifetime (a new surface needs a new patch); model: names the
+  /// nodes (whole ids); num_nodes: the length of the nodal arrays.
   ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               Index num_nodes);
+               const Model& model, Index num_nodes);
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
@@ -56,6 +60,9 @@ class ContactPatch {
   bool owned_any() const { return owned_once_; }
   /// Whether this rank owns primitive q (numbered as in own()).
   bool owns(Index q) const { return owned_mark_[q] != 0; }
+  /// The primitive (numbered as in own()) a pair belongs to: its face (vertex-face) or its
+  /// first edge (edge-edge).
+  Index primitive_of(const ContactPair& pair) const;
   /// The triangles and edges owned here (surface indices, ascending) and their nodes.
   std::span<const Index> owned_triangles() const { return owned_triangles_; }
   std::span<const Index> owned_edges() const { return owned_edges_; }
@@ -91,6 +98,8 @@ class ContactPatch {
   /// states to or receives states from in the last plan (the active one after a search), and
   /// those touching a surface node with it. Empty before the first search.
   std::span<const int> neighbors() const { return neighbors_; }
+  /// The node held here whose whole id is `whole` (every surface node is held here).
+  Index node(Index whole) const;
   /// For a surface node whose volume owner this rank is: the other ranks that read its
   /// state (their patches hold it, or they touch it), ascending.
   std::span<const int> readers(Index node) const;
@@ -107,11 +116,15 @@ class ContactPatch {
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
+  /// The surface index of the edge {a, b} (a < b, node ids here).
+  Index edge(Index a, Index b) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
   const VertexTriangles& around_;
+  const Model& model_;
   Index num_nodes_;
+  std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
   bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;

@@ -105,13 +105,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   pairs_.clear();
   if (by_body()) node_body_ = mesh.node_body;
   if (!dec_) return;
-  // The edges are sorted by their first node, so each vertex's are a range.
-  edge_offsets_.assign(surface_.vertices.size() + 1, 0);
-  for (const auto& e : surface_.edges) ++edge_offsets_[vertex_triangles_.position[e[0]] + 1];
-  std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, mesh.num_nodes());
-  ranks_ = std::make_unique<PatchRanks>(*patch_, surface_, vertex_triangles_, model_, *dec_);
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, model_, mesh.num_nodes());
+  ranks_ = std::make_unique<PatchRanks>(*patch_, model_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
@@ -194,25 +190,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
     for (const ContactPair& p : found) {
-      Index q;
-      if (p.kind == ContactPair::VertexFace) {
-        // The face among the few triangles around its first node, the edge among those
-        // from its first node: binary searches over all of them made this loop 0.24-0.35 s
-        // of a 2 x 1 run's search on the 76 cubes, these 0.09-0.16 s.
-        const std::array<Index, 3> face{p.nodes[1], p.nodes[2], p.nodes[3]};
-        const Index at = vertex_triangles_.position[face[0]];
-        q = -1;
-        for (Index i = vertex_triangles_.offsets[at]; i < vertex_triangles_.offsets[at + 1] && q < 0; ++i)
-          if (surface_.triangles[vertex_triangles_.items[i]] == face) q = vertex_triangles_.items[i];
-        SHATTER_ASSERT(q >= 0);
-      } else {
-        const std::array<Index, 2> edge{p.nodes[0], p.nodes[1]};
-        const Index at = vertex_triangles_.position[edge[0]];
-        const auto first = surface_.edges.begin() + edge_offsets_[at], last = surface_.edges.begin() + edge_offsets_[at + 1];
-        const auto it = std::find(first, last, edge);
-        SHATTER_ASSERT(it != last);
-        q = nt + static_cast<Index>(it - surface_.edges.begin());
-      }
+      const Index q = patch_->primitive_of(p);
       if (!patch_->owns(q) || excluded(p)) continue;
       pairs_.push_back(p);
       weight_[q] += 1.0f;
@@ -265,12 +243,12 @@ ContactBalance ContactStage::balance() const {
 
 std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine,
                                                           std::span<Vec3> x) const {
-  // Each rank's first pair (kind, surface positions of its nodes, their positions) to every rank.
+  // Each rank's first pair (kind, whole ids of its nodes, their positions) to every rank.
   constexpr size_t kWords = 5 + 12;
   std::vector<double> out;
   if (mine) {
     out.push_back(mine->kind);
-    for (const Index n : mine->nodes) out.push_back(vertex_triangles_.position[n]);
+    for (const Index n : mine->nodes) out.push_back(model_.whole_node(n));
     for (const Index n : mine->nodes) out.insert(out.end(), x[n].data(), x[n].data() + 3);
   }
   const std::vector<double> all = dec_->allgather(out);
@@ -278,7 +256,7 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   size_t at_first = 0;
   for (size_t at = 0; at < all.size(); at += kWords) {
     ContactPair p{static_cast<ContactPair::Kind>(all[at]), {}};
-    for (int c = 0; c < 4; ++c) p.nodes[c] = surface_.vertices[static_cast<Index>(all[at + 1 + c])];
+    for (int c = 0; c < 4; ++c) p.nodes[c] = patch_->node(static_cast<Index>(all[at + 1 + c]));
     if (!first || p < *first) first = p, at_first = at;
   }
   // Its nodes' positions here too, for the diagnosis.

@@ -154,7 +154,6 @@ class ContactStage {
   const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
-  std::vector<Index> edge_offsets_;   ///< on ranks: surface_.edges from vertex k's on (CSR by first node)
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;

@@ -346,10 +346,24 @@ void recompute_node_masses(Model& model, const std::vector<Index>& nodes) {
   }
 }
 
+namespace {
+
+/// The position of `whole` in the ascending list of a part's whole ids, -1 when absent.
+Index local_of(const std::vector<Index>& whole_ids, Index whole) {
+  const auto it = std::lower_bound(whole_ids.begin(), whole_ids.end(), whole);
+  return it != whole_ids.end() && *it == whole ? static_cast<Index>(it - whole_ids.begin()) : -1;
+}
+
+}  // namespace
+
 Index Model::local_element(Index whole) const {
   if (!is_part()) return whole < mesh.num_elements() ? whole : -1;
-  const auto it = std::lower_bound(part.element_index.begin(), part.element_index.end(), whole);
-  return it != part.element_index.end() && *it == whole ? static_cast<Index>(it - part.element_index.begin()) : -1;
+  return local_of(part.element_index, whole);
+}
+
+Index Model::local_node(Index whole) const {
+  if (!is_part()) return whole < mesh.num_nodes() ? whole : -1;
+  return local_of(part.node_index, whole);
 }
 
 std::size_t model_bytes(const Model& m) {

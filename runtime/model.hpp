@@ -96,6 +96,9 @@ struct Model {
   Index whole_node(Index n) const { return is_part() ? part.node_index[n] : n; }
   /// The local index of the whole model's element `whole`, -1 when not held here.
   Index local_element(Index whole) const;
+  /// The local index of the whole model's node `whole`, -1 when not held here. A part's
+  /// node_index must ascend (a part without fracture: its nodes keep the whole order).
+  Index local_node(Index whole) const;
   Index whole_elements() const { return is_part() ? part.whole_elements : mesh.num_elements(); }
   Index whole_nodes() const { return is_part() ? part.whole_nodes : mesh.num_nodes(); }
 };

@@ -23,9 +23,8 @@ int rank_of(std::uint64_t w) { return static_cast<int>(w) - 1; }
 
 }  // namespace
 
-PatchRanks::PatchRanks(const ContactPatch& patch, const ContactSurface& surface, const VertexTriangles& around,
-                       const Model& model, const Decomposition& dec)
-    : patch_(patch), surface_(surface), around_(around), model_(model), dec_(dec), rank_(dec.rank()) {
+PatchRanks::PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec)
+    : patch_(patch), model_(model), dec_(dec), rank_(dec.rank()) {
   MPI_Comm_dup(dec.comm(), &comm_);
 }
 
@@ -70,21 +69,21 @@ std::vector<PatchRanks::Words> PatchRanks::exchange(const std::vector<Words>& ou
 
 void PatchRanks::link(std::vector<DcrLink>& links) {
   return timed(seconds_, cpu_seconds_, [&] {
-    // To the volume owner of each link's node: its surface position, its pair's key, its tag.
+    // To the volume owner of each link's node: its whole id, its pair's key, its tag.
     const std::span<const int> neighbors = patch_.neighbors();
     std::vector<Words> out(neighbors.size());
     std::vector<DcrLink> home;  // the links of the nodes owned here, from every rank
     for (size_t k = 0; k < links.size(); ++k) {
       const auto n = static_cast<Index>(links[k].node);
-      const auto position = static_cast<std::uint64_t>(around_.position[n]);
+      const std::uint64_t whole = id(n);
       const int owner = dec_.node_owner(n);
       if (owner == rank_) {
-        home.push_back({position, links[k].key, rank_, k});
+        home.push_back({whole, links[k].key, rank_, k});
         continue;
       }
       const DcrKey& key = links[k].key;
       Words& w = out[neighbor(owner)];
-      w.insert(w.end(), {position, key.hash, key.kind, key.ids[0], key.ids[1], key.ids[2], key.ids[3], k});
+      w.insert(w.end(), {whole, key.hash, key.kind, key.ids[0], key.ids[1], key.ids[2], key.ids[3], k});
     }
     const std::vector<Words> asked = exchange(out, kLink);
     for (size_t r = 0; r < asked.size(); ++r)
@@ -114,7 +113,7 @@ void PatchRanks::link(std::vector<DcrLink>& links) {
 }
 
 void PatchRanks::append(Words& w, Index node, const Vec3& x_new, const Vec3& v) const {
-  w.insert(w.end(), {static_cast<std::uint64_t>(around_.position[node]), word(x_new.x()), word(x_new.y()),
+  w.insert(w.end(), {id(node), word(x_new.x()), word(x_new.y()),
                      word(x_new.z()), word(v.x()), word(v.y()), word(v.z())});
 }
 
@@ -150,7 +149,7 @@ std::vector<DcrNodeState> PatchRanks::receive(bool wait) {
       Words w(count);
       MPI_Recv(w.data(), count, MPI_UINT64_T, status.MPI_SOURCE, kPost, comm_, MPI_STATUS_IGNORE);
       for (size_t at = 0; at < w.size(); at += kStateWords + 1)
-        states.push_back({surface_.vertices[static_cast<Index>(w[at])],
+        states.push_back({patch_.node(static_cast<Index>(w[at])),
                           Vec3(real(w[at + 1]), real(w[at + 2]), real(w[at + 3])),
                           Vec3(real(w[at + 4]), real(w[at + 5]), real(w[at + 6])), w[at + 7] != 0});
     }
@@ -175,7 +174,7 @@ std::vector<Index> PatchRanks::settle(std::span<const Index> last, std::span<Vec
     auto write = [&](const std::vector<Words>& in, bool owned) {
       for (size_t r = 0; r < in.size(); ++r)
         for (size_t at = 0; at < in[r].size(); at += kStateWords) {
-          const Index n = surface_.vertices[static_cast<Index>(in[r][at])];
+          const Index n = patch_.node(static_cast<Index>(in[r][at]));
           x_new[n] = Vec3(real(in[r][at + 1]), real(in[r][at + 2]), real(in[r][at + 3]));
           v[n] = Vec3(real(in[r][at + 4]), real(in[r][at + 5]), real(in[r][at + 6]));
           written.push_back(n);

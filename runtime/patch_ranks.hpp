@@ -26,10 +26,9 @@ struct Model;
 
 class PatchRanks final : public DcrRanks {
  public:
-  /// The patch (of `surface`, whose vertex positions name the nodes between ranks) must
-  /// outlive this. Collective (duplicates the communicator).
-  PatchRanks(const ContactPatch& patch, const ContactSurface& surface, const VertexTriangles& around,
-             const Model& model, const Decomposition& dec);
+  /// The patch must outlive this. Between ranks nodes are named by their whole ids (model).
+  /// Collective (duplicates the communicator).
+  PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec);
   ~PatchRanks() override;
   PatchRanks(const PatchRanks&) = delete;
   PatchRanks& operator=(const PatchRanks&) = delete;
@@ -59,8 +58,6 @@ class PatchRanks final : public DcrRanks {
   void append(Words& w, Index node, const Vec3& x_new, const Vec3& v) const;
 
   const ContactPatch& patch_;
-  const ContactSurface& surface_;
-  const VertexTriangles& around_;
   const Model& model_;
   const Decomposition& dec_;
   MPI_Comm comm_ = MPI_COMM_NULL;
