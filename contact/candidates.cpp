@@ -53,19 +53,6 @@ void fill_boxes(std::vector<Box>& out, const Nodes& nodes, std::span<const Vec3>
                     });
 }
 
-/// Pairs collected in per-thread buffers. Which buffer holds a pair depends
-/// on the schedule; canonicalize after concatenation makes the list unique.
-using PairBuffers = tbb::enumerable_thread_specific<ContactPairs>;
-
-ContactPairs concatenate(PairBuffers& buffers) {
-  size_t total = 0;
-  for (const auto& b : buffers) total += b.size();
-  ContactPairs all;
-  all.reserve(total);
-  for (const auto& b : buffers) all.insert(all.end(), b.begin(), b.end());
-  return all;
-}
-
 }  // namespace
 
 SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old,
@@ -128,22 +115,32 @@ ContactPairs find_candidates(const ContactSurface& surface, std::span<const Vec3
   return find_candidates(surface, swept_boxes(surface, x_old, x_new));
 }
 
-ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& boxes) {
+namespace {
+
+/// The search of find_candidates: out(pair, primitive) for every candidate (the primitive
+/// being the face, or the first edge, numbered as in OwnedPairs), on the thread's
+/// buffer; an edge-edge pair only when its first edge is kept (kept_edges empty: all).
+template <class Record, class Make>
+std::vector<Record> search_pairs(const ContactSurface& surface, const SweptBoxes& boxes,
+                                 std::span<const std::uint8_t> kept_edges, Make make) {
   SparseBucket triangles, edges;
   tbb::parallel_invoke([&] { triangles = build_sparse_bucket(boxes.triangles); },
                        [&] { edges = build_sparse_bucket(boxes.edges); });
-  PairBuffers buffers;
+  tbb::enumerable_thread_specific<std::vector<Record>> buffers;
   // One range of independent tasks: vertex queries against the triangles,
   // then the edge self join by cells, then edges against larger edges on
   // higher levels (none when all edges share one level).
   const size_t nv = boxes.vertices.size(), nc = edges.cell_key.size();
   const size_t ne_above = edges.num_levels() > 1 ? boxes.edges.size() : 0;
+  const auto nt = static_cast<Index>(surface.triangles.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv + nc + ne_above, 64),
                     [&](const tbb::blocked_range<size_t>& r) {
-                      ContactPairs& out = buffers.local();
+                      std::vector<Record>& out = buffers.local();
                       auto add_edge_pair = [&](Index a, Index b) {
-                        if (auto p = edge_edge_pair(surface, std::min(a, b), std::max(a, b)))
-                          out.push_back(*p);
+                        const Index first = std::min(a, b);
+                        if (!kept_edges.empty() && !kept_edges[first]) return;
+                        if (auto p = edge_edge_pair(surface, first, std::max(a, b)))
+                          out.push_back(make(*p, nt + first));
                       };
                       for (size_t k = r.begin(); k != r.end(); ++k) {
                         if (k < nv) {
@@ -151,7 +148,7 @@ ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& bo
                           query_sparse_bucket(triangles, boxes.triangles, boxes.vertices[k],
                                               [&](Index t) {
                                                 if (auto p = vertex_face_pair(surface, v, t))
-                                                  out.push_back(*p);
+                                                  out.push_back(make(*p, t));
                                               });
                         } else if (k < nv + nc) {
                           self_join_sparse_bucket_cell(edges, boxes.edges,
@@ -162,9 +159,38 @@ ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& bo
                         }
                       }
                     });
-  ContactPairs pairs = concatenate(buffers);
+  // Which buffer holds a record depends on the schedule; the caller's sort on a total
+  // order makes the list unique.
+  size_t total = 0;
+  for (const auto& b : buffers) total += b.size();
+  std::vector<Record> all;
+  all.reserve(total);
+  for (const auto& b : buffers) all.insert(all.end(), b.begin(), b.end());
+  return all;
+}
+
+}  // namespace
+
+ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& boxes) {
+  ContactPairs pairs =
+      search_pairs<ContactPair>(surface, boxes, {}, [](const ContactPair& p, Index) { return p; });
   canonicalize(pairs);
   return pairs;
+}
+
+OwnedPairs find_owned_candidates(const ContactSurface& surface, const SweptBoxes& boxes,
+                                 std::span<const std::uint8_t> kept_edges) {
+  using Record = std::pair<ContactPair, Index>;
+  std::vector<Record> found = search_pairs<Record>(surface, boxes, kept_edges,
+                                                   [](const ContactPair& p, Index q) { return Record{p, q}; });
+  // A pair has one first primitive, so sorting by pair orders the records totally.
+  tbb::parallel_sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  OwnedPairs out;
+  out.pairs.reserve(found.size());
+  out.primitive.reserve(found.size());
+  for (const auto& [p, q] : found) out.pairs.push_back(p), out.primitive.push_back(q);
+  return out;
 }
 
 ContactPairs find_candidates_brute_force(const ContactSurface& surface, const SweptBoxes& boxes) {

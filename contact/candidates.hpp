@@ -3,6 +3,7 @@
 // over one step, and the candidate vertex-face and edge-edge pairs whose
 // boxes overlap (DESIGN.md "The physics", step 2; the DCR narrow phase
 // decides which of them really penetrate).
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -67,6 +68,19 @@ ContactPairs find_candidates(const ContactSurface& surface, std::span<const Vec3
 
 /// find_candidates on boxes already computed by swept_boxes.
 ContactPairs find_candidates(const ContactSurface& surface, const SweptBoxes& boxes);
+
+/// Candidates with the primitive each belongs to: the face of a vertex-face pair (triangle t
+/// as t), the first edge of an edge-edge pair (edge e as the number of triangles + e).
+struct OwnedPairs {
+  ContactPairs pairs;            ///< canonical order
+  std::vector<Index> primitive;  ///< per pair
+};
+
+/// find_candidates on boxes, with each pair's primitive, and only the edge-edge pairs whose
+/// first edge is kept (kept_edges: per edge, 1 to keep; empty: all): a rank's patch keeps
+/// the pairs of its own edges and never makes those of two ghosts.
+OwnedPairs find_owned_candidates(const ContactSurface& surface, const SweptBoxes& boxes,
+                                 std::span<const std::uint8_t> kept_edges);
 
 /// The definition find_candidates must equal: every pair of boxes tested,
 /// O(vertices x triangles + edges^2). For tests and small benchmarks.

@@ -80,16 +80,9 @@ Index ContactPatch::edge(Index a, Index b) const {
   return static_cast<Index>(it - surface_.edges.begin());
 }
 
-Index ContactPatch::primitive_of(const ContactPair& p) const {
-  if (p.kind == ContactPair::EdgeEdge) return surface_.num_triangles() + edge(p.nodes[0], p.nodes[1]);
-  // The face among the few triangles around its first node: binary searches over all of
-  // them made this 0.24-0.35 s of a 2 x 1 run's search on the 76 cubes, this 0.09-0.16 s.
-  const std::array<Index, 3> face{p.nodes[1], p.nodes[2], p.nodes[3]};
-  const Index at = around_.position[face[0]];
-  for (Index i = around_.offsets[at]; i < around_.offsets[at + 1]; ++i)
-    if (surface_.triangles[around_.items[i]] == face) return around_.items[i];
-  SHATTER_ASSERT(false);
-  return -1;
+Index ContactPatch::surface_primitive(Index q) const {
+  const auto nt = static_cast<Index>(owned_triangles_.size());
+  return q < nt ? owned_triangles_[q] : surface_.num_triangles() + patch_edges_[q - nt];
 }
 
 void ContactPatch::own(std::span<const Index> primitives) {
@@ -133,7 +126,8 @@ void ContactPatch::sort_marked(std::vector<Index>& nodes) {
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
                          std::span<const double> node_reach) {
   const int ranks = dec_.size(), me = dec_.rank();
-  const SweptBoxes own = inflated_boxes(owned_, x_old, x_new, margin, node_reach);
+  owned_boxes_ = inflated_boxes(owned_, x_old, x_new, margin, node_reach);
+  const SweptBoxes& own = owned_boxes_;
   const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, node_reach);
   Box mine = empty_box();
   for (const auto* list : {&own.triangles, &own.edges})
@@ -169,6 +163,9 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_.body = owned_.body;
   for (const Index e : edges) patch_.edges.push_back(surface_.edges[e]);
   patch_.vertices = std::move(vertices);
+  patch_edges_ = std::move(edges);
+  patch_edge_owned_.resize(patch_edges_.size());
+  for (size_t k = 0; k < patch_edges_.size(); ++k) patch_edge_owned_[k] = owns(surface_.num_triangles() + patch_edges_[k]);
   // The patch's nodes, made unique by marks: sorting the list with its repeats (each node
   // ~7 times) took a third of reach()'s CPU time on the 76 cubes.
   node_mark_.resize(num_nodes_, 0);
@@ -181,6 +178,23 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   sort_marked(needed);
   plans_[static_cast<int>(PatchPlan::Patch)] = plan(needed, false);
   plans_[static_cast<int>(PatchPlan::Active)].reset();
+}
+
+SweptBoxes ContactPatch::patch_boxes(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
+                                     std::span<const double> node_reach) const {
+  // The ghost edges' boxes and the vertices' are new; the owned triangles (all of the
+  // patch's) and edges keep those of reach().
+  ContactSurface rest;
+  for (size_t k = 0; k < patch_.edges.size(); ++k)
+    if (!patch_edge_owned_[k]) rest.edges.push_back(patch_.edges[k]);
+  rest.vertices = patch_.vertices;
+  SweptBoxes boxes = inflated_boxes(rest, x_old, x_new, margin, node_reach);
+  std::vector<Box> ghost_edges = std::move(boxes.edges);
+  boxes.triangles = owned_boxes_.triangles;
+  boxes.edges.resize(patch_.edges.size());
+  for (size_t k = 0, own = 0, ghost = 0; k < patch_.edges.size(); ++k)
+    boxes.edges[k] = patch_edge_owned_[k] ? owned_boxes_.edges[own++] : ghost_edges[ghost++];
+  return boxes;
 }
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {

@@ -60,9 +60,6 @@ class ContactPatch {
   bool owned_any() const { return owned_once_; }
   /// Whether this rank owns primitive q (numbered as in own()).
   bool owns(Index q) const { return owned_mark_[q] != 0; }
-  /// The primitive (numbered as in own()) a pair belongs to: its face (vertex-face) or its
-  /// first edge (edge-edge).
-  Index primitive_of(const ContactPair& pair) const;
   /// The triangles and edges owned here (surface indices, ascending) and their nodes.
   std::span<const Index> owned_triangles() const { return owned_triangles_; }
   std::span<const Index> owned_edges() const { return owned_edges_; }
@@ -82,6 +79,14 @@ class ContactPatch {
   void activate(std::span<const ContactPair> pairs);
   /// The surface the search runs on here (surface order, node ids of the mesh).
   const ContactSurface& patch() const { return patch_; }
+  /// Per edge of patch(): 1 if owned here (find_owned_candidates keeps their pairs).
+  std::span<const std::uint8_t> patch_edges_owned() const { return patch_edge_owned_; }
+  /// The patch's inflated boxes for the search (inflated_boxes of patch(), with the owned
+  /// primitives' from reach(); their states must be unchanged since, the rest here).
+  SweptBoxes patch_boxes(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
+                         std::span<const double> node_reach = {}) const;
+  /// The primitive (numbered as in own()) of a primitive of patch() (as in OwnedPairs).
+  Index surface_primitive(Index patch_primitive) const;
   /// The triangles whose normals the active pairs read, ascending.
   std::span<const Index> normal_triangles() const { return normal_triangles_; }
   /// The surface vertices whose volume owner this rank is, ascending.
@@ -130,6 +135,9 @@ class ContactPatch {
   std::vector<Index> owned_triangles_, owned_edges_;
   std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
   ContactSurface owned_, patch_;
+  SweptBoxes owned_boxes_;                  ///< inflated boxes of owned_ at the last reach()
+  std::vector<Index> patch_edges_;          ///< per edge of patch_: its surface index
+  std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
   std::vector<Index> normal_triangles_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach() and activate(), 0 between calls
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan

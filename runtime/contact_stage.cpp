@@ -185,15 +185,16 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     patch_->reach(x_old, x_new, margin_, reach_);
     exchange(x_old, x_new, v, PatchPlan::Patch);
     const double cpu0 = thread_cpu_seconds();
-    const ContactPairs found = find_candidates(patch_->patch(), inflated_boxes(patch_->patch(), x_old, x_new, margin_, reach_));
-    // Keep the pairs of this rank's primitives, and count them per primitive (the weights).
+    // The pairs of this rank's primitives (the patch's triangles are all its own; the pairs of
+    // a ghost first edge are another rank's), counted per primitive (the weights).
+    const OwnedPairs found = find_owned_candidates(
+        patch_->patch(), patch_->patch_boxes(x_old, x_new, margin_, reach_), patch_->patch_edges_owned());
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
-    for (const ContactPair& p : found) {
-      const Index q = patch_->primitive_of(p);
-      if (!patch_->owns(q) || excluded(p)) continue;
-      pairs_.push_back(p);
-      weight_[q] += 1.0f;
+    for (size_t k = 0; k < found.pairs.size(); ++k) {
+      if (excluded(found.pairs[k])) continue;
+      pairs_.push_back(found.pairs[k]);
+      weight_[patch_->surface_primitive(found.primitive[k])] += 1.0f;
     }
     profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
     const long mine = static_cast<long>(pairs_.size());

@@ -214,6 +214,39 @@ TEST(Candidates, SameListForOneTwoFourThreads) {
   EXPECT_TRUE(results[2] == results[0]);
 }
 
+TEST(Candidates, OwnedCandidatesAreThePairsOfTheKeptEdgesWithTheirPrimitive) {
+  // Every third edge kept: the vertex-face pairs all stay, the edge-edge pairs of a kept
+  // first edge stay, each with the index of its face or first edge.
+  const Soup soup = random_soup(5, 3000, 0.1);
+  const ContactSurface s = make_contact_surface(soup.triangles);
+  const SweptBoxes boxes = swept_boxes(s, soup.x_old, soup.x_new);
+  std::vector<std::uint8_t> kept(s.edges.size());
+  for (size_t e = 0; e < kept.size(); ++e) kept[e] = e % 3 == 0;
+  const OwnedPairs owned = find_owned_candidates(s, boxes, kept);
+  ContactPairs expected;
+  std::vector<Index> primitive;
+  for (const ContactPair& p : find_candidates(s, boxes)) {
+    Index q;
+    if (p.kind == ContactPair::VertexFace) {
+      const std::array<Index, 3> face{p.nodes[1], p.nodes[2], p.nodes[3]};
+      q = static_cast<Index>(std::find(s.triangles.begin(), s.triangles.end(), face) - s.triangles.begin());
+    } else {
+      const std::array<Index, 2> edge{p.nodes[0], p.nodes[1]};
+      const auto e = std::lower_bound(s.edges.begin(), s.edges.end(), edge) - s.edges.begin();
+      if (!kept[e]) continue;
+      q = s.num_triangles() + static_cast<Index>(e);
+    }
+    expected.push_back(p);
+    primitive.push_back(q);
+  }
+  const auto edge_pairs = std::count_if(expected.begin(), expected.end(),
+                                        [](const ContactPair& p) { return p.kind == ContactPair::EdgeEdge; });
+  EXPECT_GT(edge_pairs, 100);
+  EXPECT_GT(static_cast<long>(expected.size()) - edge_pairs, 100);
+  EXPECT_TRUE(owned.pairs == expected);
+  EXPECT_TRUE(owned.primitive == primitive);
+}
+
 TEST(Candidates, EmptySurfaceHasNoCandidates) {
   const ContactSurface s;
   const std::vector<Vec3> x;
