@@ -23,7 +23,7 @@
 #       the two boxes with contact, ELEMENTS tets in all (default 4000000) on
 #       RANKS ranks (default 16, oversubscribed), 50 steps of 2e-6 s (they meet
 #       after 5e-5 s): each rank's peak memory, their sum, and the contacts.
-#   [FIRST=R0] bench/mpi_scaling.sh BUILD fracture [PER_RANK] [MAX_RANKS]
+#   [FIRST=R0 | RANKS="R ..."] [SHAPE=cube|bar] bench/mpi_scaling.sh BUILD fracture [PER_RANK] [MAX_RANKS]
 #       weak scaling with fracture (issue 15): an aluminium block (the ring's
 #       material) under a uniform expansion of 2e4 /s cracks everywhere (a hot
 #       field; no contact, so the ranks hold parts with two ghost layers). The
@@ -32,6 +32,14 @@
 #       MAX_RANKS (default 64, oversubscribed), to 1e-7 s: per rank peak memory
 #       and model bytes, ghost bytes and messages per step, and the largest
 #       rank's facet check and insertion thread CPU time per step.
+#       SHAPE=bar: the block grows along x only (R s x s x s), at a fixed
+#       square cross-section of side s with s^3 = the volume of PER_RANK tets
+#       (1.6e-3 m at 20000), so that METIS cuts it into R slabs across its
+#       length: every part but the two ends shares two faces (two ghost
+#       messages) at any rank count, which the cube (corners at 8 ranks,
+#       interiors at 64) does not. (Slabs of s x s x s/2 were too thin: their
+#       wavy cuts gave 5 messages at 8 ranks.) Results go to
+#       mpi_scaling_fracture_bar.csv. RANKS="8 64" runs those counts only.
 #
 # Results: bench/results/mpi_scaling_<mode>.csv
 set -euo pipefail
@@ -162,19 +170,30 @@ elif [ "$mode" = fracture ]; then
   per_rank=${3:-20000}
   max_ranks=${4:-64}
   block="$here/fracture_block.yaml"
-  out="$here/results/mpi_scaling_fracture.csv"
+  shape=${SHAPE:-cube}
+  case "$shape" in
+    cube) out="$here/results/mpi_scaling_fracture.csv" ;;
+    bar) out="$here/results/mpi_scaling_fracture_bar.csv" ;;
+    *) echo "mpi_scaling.sh: SHAPE=$shape: expected cube or bar" >&2; exit 2 ;;
+  esac
   echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,cohesive_elements,check_cpu_ms_per_step_max,insert_cpu_ms_per_step_max" > "$out"
-  r=${FIRST:-1}
-  while [ "$r" -le "$max_ranks" ]; do
+  ranks=${RANKS:-$(r=${FIRST:-1}; while [ "$r" -le "$max_ranks" ]; do echo "$r"; r=$((r * 2)); done)}
+  for r in $ranks; do
     # 10 561 tets for a side of 1.3e-3 m at this element size.
-    side=$(python3 -c "print(f'{1.3e-3 * ($per_rank * $r / 10561) ** (1 / 3):.6e}')")
+    size=$(python3 -c "
+v = 1.3e-3 ** 3 * $per_rank / 10561  # one rank's volume
+if '$shape' == 'cube':
+    side = ($r * v) ** (1 / 3)
+    print(f'{side:.6e}, {side:.6e}, {side:.6e}')
+else:
+    s = v ** (1 / 3)
+    print(f'{$r * s:.6e}, {s:.6e}, {s:.6e}')")
     dir="$work/fracture$r"
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$block" --out "$dir" --threads 1 --quiet \
-      --set "bodies[0].mesh.size=[$side, $side, $side]" 2> /dev/null
+      --set "bodies[0].mesh.size=[$size]" 2> /dev/null
     steps=$(key "$dir" steps)
     per_step() { key "$dir" "$1" | awk -v n="$steps" '{printf "%.3f", 1e3 * $1 / n}'; }
     echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max),$steps,$(key "$dir" cohesive_elements),$(per_step fracture_check_cpu_time_max),$(per_step fracture_insert_cpu_time_max)" | tee -a "$out"
-    r=$((r * 2))
   done
 else
   per_rank=${3:-2000}
