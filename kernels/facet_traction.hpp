@@ -72,6 +72,21 @@ struct FacetTractionLanes {
   double traction[N];      ///< out: effective traction t_eff, Pa
 };
 
+/// (b - a) x (c - a) of lane l's corner triangle, the operations of Eigen's
+/// cross product: facet_traction_lanes and facet_criterion_lanes share its bits.
+template <int N, int S>
+[[gnu::always_inline]] inline void facet_cross(const FacetTractionLanes<N, S>& L, int l, double& c0, double& c1,
+                                               double& c2) {
+  double u[3], v[3];
+  for (int i = 0; i < 3; ++i) {
+    u[i] = L.x[3 + i][l] - L.x[i][l];
+    v[i] = L.x[6 + i][l] - L.x[i][l];
+  }
+  c0 = u[1] * v[2] - u[2] * v[1];
+  c1 = u[2] * v[0] - u[0] * v[2];
+  c2 = u[0] * v[1] - u[1] * v[0];
+}
+
 /// Effective traction of N facets: n the unit normal (b - a) x (c - a) /
 /// |(b - a) x (c - a)| of the corner triangle (0 if degenerate), sigma the
 /// mean of the two elements' stresses, then effective_traction_lane. The
@@ -84,14 +99,8 @@ template <int N, int S>
 inline void facet_traction_lanes(FacetTractionLanes<N, S>& L) {
   double n[3][N], sigma[9][N];
   for (int l = 0; l < N; ++l) {
-    double u[3], v[3];
-    for (int i = 0; i < 3; ++i) {
-      u[i] = L.x[3 + i][l] - L.x[i][l];
-      v[i] = L.x[6 + i][l] - L.x[i][l];
-    }
-    const double c0 = u[1] * v[2] - u[2] * v[1];
-    const double c1 = u[2] * v[0] - u[0] * v[2];
-    const double c2 = u[0] * v[1] - u[1] * v[0];
+    double c0, c1, c2;
+    facet_cross(L, l, c0, c1, c2);
     const double z = c0 * c0 + c1 * c1 + c2 * c2;
     const double r = z > 0 ? std::sqrt(z) : 1.0;  // Eigen: a zero vector stays zero
     n[0][l] = c0 / r;
@@ -102,6 +111,53 @@ inline void facet_traction_lanes(FacetTractionLanes<N, S>& L) {
     for (int q = 0; q < 9; ++q) sigma[q][l] = mean[S == 6 ? kVoigtOfRowMajor[q] : q];
   }
   for (int l = 0; l < N; ++l) L.traction[l] = effective_traction_lane(sigma, n, L.beta[l], l);
+}
+
+/// The decision t_eff >= strength of facet_traction_lanes for N facets,
+/// without its divisions and square roots (the bulk of its time, slow in wide
+/// vectors). With c = (b - a) x (c - a), z = |c|^2 (n = c / sqrt(z)) and
+/// w = (sigma_0 + sigma_1) c = 2 sigma c, p = c . w, q = |w|^2: tn = p / 2z,
+/// tau^2 = q / 4z - tn^2, so t_eff >= sigma_c, times 4 z^2 beta^2 > 0, is
+///   D = <p>^2 beta^2 + (q z - p^2) - (2 sigma_c beta z)^2 >= 0.
+/// Lane l is decided, breaks[l] = D > 0, only where |D| exceeds
+///   1e-10 ((p^2 + q z)(1 + beta^2) + (2 sigma_c beta z)^2):
+/// D's round-off (some 30 roundings of terms bounded by that sum, p^2 <= q z)
+/// and that of facet_traction_lanes' t_eff^2 (terms bounded by
+/// |t|^2 (1 + 1 / beta^2), scaled alike) are each below 1e-14 of it, with c
+/// the same bits in both (facet_cross), so the decision is that of
+/// t_eff >= strength. Elsewhere (within the margin, a degenerate or extreme
+/// z, inf or NaN) undecided[l] is set: evaluate those lanes with
+/// facet_traction_lanes. L.traction is not read.
+template <int N, int S>
+inline void facet_criterion_lanes(const FacetTractionLanes<N, S>& L, const double (&strength)[N], bool (&breaks)[N],
+                                  bool (&undecided)[N]) {
+  double d[N], margin[N], z_of[N];
+  for (int l = 0; l < N; ++l) {  // vectorised across lanes: no branch, no bool in it
+    double c[3];
+    facet_cross(L, l, c[0], c[1], c[2]);
+    const double z = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    double sum[9];
+    for (int q = 0; q < 9; ++q) {
+      const int k = S == 6 ? kVoigtOfRowMajor[q] : q;
+      sum[q] = L.stress[0][k][l] + L.stress[1][k][l];
+    }
+    const double w0 = sum[0] * c[0] + sum[1] * c[1] + sum[2] * c[2];
+    const double w1 = sum[3] * c[0] + sum[4] * c[1] + sum[5] * c[2];
+    const double w2 = sum[6] * c[0] + sum[7] * c[1] + sum[8] * c[2];
+    const double p = c[0] * w0 + c[1] * w1 + c[2] * w2;
+    const double qz = (w0 * w0 + w1 * w1 + w2 * w2) * z;
+    const double b2 = L.beta[l] * L.beta[l];
+    const double p_pos = std::max(p, 0.0), g = 2.0 * strength[l] * L.beta[l] * z;
+    d[l] = p_pos * p_pos * b2 + (qz - p * p) - g * g;
+    margin[l] = 1e-10 * ((p * p + qz) * (1.0 + b2) + g * g);
+    z_of[l] = z;
+  }
+  for (int l = 0; l < N; ++l) {
+    // z within [1e-150, 1e150]: z^2 and the terms neither underflow nor overflow.
+    const bool decided = (std::abs(d[l]) > margin[l]) & (z_of[l] >= 1e-150) & (z_of[l] <= 1e150);
+    breaks[l] = d[l] > 0;
+    undecided[l] = !decided;
+  }
 }
 
 }  // namespace shatter

@@ -3,6 +3,9 @@
 // check evaluated before (so the check decides the same facets), whatever
 // its lane and the number of lanes; the analytic traction of a uniaxial
 // stress on an inclined facet; a zero-area facet carries no traction.
+// facet_criterion_lanes (the decisions without divisions or square roots)
+// decides every lane it decides as t_eff >= strength does, leaves undecided
+// the strengths within an ulp of t_eff, and decides those 30 % away.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -146,4 +149,52 @@ TEST(FacetTraction, AZeroAreaFacetCarriesNoTraction) {
   facet_traction_lanes(L);  // lane 0: three coincident corners; lane 1: collinear ones
   EXPECT_EQ(L.traction[0], 0.0);
   EXPECT_EQ(L.traction[1], 0.0);
+}
+
+TEST(FacetTraction, CriterionLanesDecideAsTheTraction) {
+  // Each facet's strength is its own t_eff scaled by one of these: ulps and
+  // 1e-12 from it must be left undecided, 30 % from it decided.
+  const double t = 1.0;
+  const double scale[] = {std::nextafter(t, 0.0), t, std::nextafter(t, 2.0), 1 - 1e-12, 1 + 1e-12, 0.7, 1.3};
+  constexpr int kScales = sizeof(scale) / sizeof(scale[0]);
+  constexpr int kLanes = 8;
+  const std::vector<Facet> facets = random_facets(40000);
+  int wrong = 0, near_decided = 0, far_undecided = 0, far = 0;
+  for (size_t k0 = 0; k0 + kLanes <= facets.size(); k0 += kLanes)
+    for (int i = 0; i < kScales; ++i) {
+      auto check = [&]<int S>(FacetTractionLanes<kLanes, S> L) {
+        double strength[kLanes];
+        for (int l = 0; l < kLanes; ++l) strength[l] = scale[(i + l) % kScales] * L.traction[l];
+        bool breaks[kLanes], undecided[kLanes];
+        facet_criterion_lanes(L, strength, breaks, undecided);
+        for (int l = 0; l < kLanes; ++l) {
+          const double s = scale[(i + l) % kScales];
+          const bool is_far = s == 0.7 || s == 1.3;
+          wrong += !undecided[l] && breaks[l] != (L.traction[l] >= strength[l]);
+          near_decided += !is_far && !undecided[l];
+          far += is_far;
+          far_undecided += is_far && undecided[l];
+        }
+      };
+      check(evaluated<kLanes, 6>(facets, k0));
+      check(evaluated<kLanes, 9>(facets, k0));
+    }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(near_decided, 0);
+  EXPECT_GT(far, 20000);
+  EXPECT_EQ(far_undecided, 0);
+}
+
+TEST(FacetTraction, CriterionLanesLeaveAZeroAreaFacetUndecided) {
+  FacetTractionLanes<2, 9> L;
+  for (int l = 0; l < 2; ++l) {
+    for (int q = 0; q < 9; ++q) L.x[q][l] = 0.25 * (q % 3) + (l == 1 ? 0.125 * (q / 3) : 0.0);
+    for (int q = 0; q < 9; ++q) L.stress[0][q][l] = L.stress[1][q][l] = q % 4 == 0 ? 1e9 : 0.0;
+    L.beta[l] = 1.0;
+  }
+  const double strength[2] = {1e6, 1e6};
+  bool breaks[2], undecided[2];
+  facet_criterion_lanes(L, strength, breaks, undecided);
+  EXPECT_TRUE(undecided[0]);
+  EXPECT_TRUE(undecided[1]);
 }
