@@ -80,7 +80,7 @@ def run(build, v, H, h, r, order):
     if h < H and r > 0:
         sets += [f"bodies[{b}].mesh.refine=[{{center: [0, 0, 0], radius: {r}, element_size: {h}}}]" for b in (0, 1)]
     with tempfile.TemporaryDirectory() as d:
-        cmd = ["nice", "-n", "10", os.path.join(build, "apps", "shatter"), "run", SCENE, "--out", d, "--threads", "1",
+        cmd = ["nice", "-n", "15", os.path.join(build, "apps", "shatter"), "run", SCENE, "--out", d, "--threads", "1",
                "--quiet"]
         for s in sets:
             cmd += ["--set", s]
