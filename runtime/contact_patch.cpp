@@ -291,13 +291,18 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   }
   sort_marked(needed);
   std::sort(triangles.begin(), triangles.end());
-  // reach() holds the triangles around the patch's nodes in the patch.
-  std::vector<SurfaceTriangle> around;
+  // reach() holds the triangles around the patch's nodes in the patch. Only the triangles,
+  // their vertices and the vertex -> triangle lists are made (surface_normal's needs).
+  normals_ = {};
+  std::vector<char> vertex(nodes_.size(), 0);
   for (const Index t : triangles) {
     const auto& [a, b, c] = surface_.triangles[t];
-    around.push_back({{position_[a], position_[b], position_[c]}, surface_.body[t]});
+    normals_.triangles.push_back({position_[a], position_[b], position_[c]});
+    normals_.body.push_back(surface_.body[t]);
+    for (const Index n : normals_.triangles.back()) vertex[n] = 1;
   }
-  normals_ = make_contact_surface(around);
+  for (size_t k = 0; k < vertex.size(); ++k)
+    if (vertex[k]) normals_.vertices.push_back(static_cast<Index>(k));
   normals_around_ = vertex_triangles(normals_);
   auto& lists = lists_[static_cast<int>(PatchPlan::Active)];
   lists = plan(needed, true);

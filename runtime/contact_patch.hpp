@@ -91,7 +91,8 @@ class ContactPatch {
   /// The primitive (numbered as in own()) of a primitive of patch() (as in OwnedPairs).
   Index surface_primitive(Index patch_primitive) const;
   /// The triangles whose normals the active pairs read (those around their nodes), in
-  /// surface order, with their vertex -> triangle lists (patch node ids).
+  /// surface order, and their vertices (no edges), with their vertex -> triangle lists
+  /// (patch node ids).
   const ContactSurface& normals() const { return normals_; }
   const VertexTriangles& normals_around() const { return normals_around_; }
   /// The surface vertices whose volume owner this rank is, ascending (part node ids).
