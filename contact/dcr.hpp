@@ -78,7 +78,7 @@ struct FoundPair {
 
 /// A node's state as it passes between ranks during a resolution round.
 struct DcrNodeState {
-  Index node = 0;  ///< mesh node id (this rank's)
+  Index node = 0;  ///< node id of the nodal arrays (this rank's)
   Vec3 x_new, v;
   bool moved = false;  ///< a pair moved the node in this round (this or an earlier one on the node)
 };
@@ -95,7 +95,7 @@ class DcrRanks {
   virtual std::uint64_t id(Index node) const = 0;
   /// The sum of count over the ranks (collective).
   virtual long total(long count) = 0;
-  /// Orders this rank's links (node = mesh node id, rank = rank()) with every rank's, as
+  /// Orders this rank's links (node = node id of the arrays, rank = rank()) with every rank's, as
   /// order_links would the union: pred and succ are set (the order of `links` may change;
   /// collective).
   virtual void link(std::vector<DcrLink>& links) = 0;

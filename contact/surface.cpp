@@ -138,25 +138,18 @@ void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> tri
 }
 
 VertexTriangles vertex_triangles(const ContactSurface& surface) {
-  std::vector<std::pair<Index, Index>> incidence;  // (position in vertices, triangle)
-  incidence.reserve(3 * surface.triangles.size());
-  for (size_t t = 0; t < surface.triangles.size(); ++t)
-    for (const Index n : surface.triangles[t]) {
-      const auto it = std::lower_bound(surface.vertices.begin(), surface.vertices.end(), n);
-      incidence.emplace_back(static_cast<Index>(it - surface.vertices.begin()),
-                             static_cast<Index>(t));
-    }
-  std::sort(incidence.begin(), incidence.end());
+  // A counting sort: the triangles are visited in order, so each vertex's come ascending.
   VertexTriangles out;
-  out.offsets.assign(surface.vertices.size() + 1, 0);
-  out.items.reserve(incidence.size());
-  for (const auto& [k, t] : incidence) {
-    ++out.offsets[k + 1];
-    out.items.push_back(t);
-  }
-  for (size_t k = 0; k < surface.vertices.size(); ++k) out.offsets[k + 1] += out.offsets[k];
   out.position.assign(surface.vertices.empty() ? 0 : surface.vertices.back() + 1, -1);
   for (size_t k = 0; k < surface.vertices.size(); ++k) out.position[surface.vertices[k]] = static_cast<Index>(k);
+  out.offsets.assign(surface.vertices.size() + 1, 0);
+  for (const auto& t : surface.triangles)
+    for (const Index n : t) ++out.offsets[out.position[n] + 1];
+  for (size_t k = 0; k < surface.vertices.size(); ++k) out.offsets[k + 1] += out.offsets[k];
+  out.items.resize(out.offsets.back());
+  std::vector<Index> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (size_t t = 0; t < surface.triangles.size(); ++t)
+    for (const Index n : surface.triangles[t]) out.items[fill[out.position[n]]++] = static_cast<Index>(t);
   return out;
 }
 

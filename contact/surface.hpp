@@ -75,7 +75,7 @@ struct VertexTriangles {
   std::vector<Index> position;
 };
 
-/// The vertex -> triangle CSR of a surface, O(t log t).
+/// The vertex -> triangle CSR of a surface, O(t + v + its largest vertex).
 VertexTriangles vertex_triangles(const ContactSurface& surface);
 
 /// Each triangle's (x1 - x0) x (x2 - x0) at x (m^2) and its length, in surface order:

@@ -48,29 +48,37 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 }
 
 ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-                           const Model& model, Index num_nodes)
-    : dec_(dec), surface_(surface), around_(around), model_(model), num_nodes_(num_nodes) {
+                           const Model& model, Index num_nodes, std::span<const double> node_reach)
+    : dec_(dec), surface_(surface), around_(around), model_(model), num_nodes_(num_nodes), part_reach_(node_reach) {
   // The edges are sorted by their first node, so each vertex's are a range.
   edge_offsets_.assign(surface.vertices.size() + 1, 0);
   for (const auto& e : surface.edges) ++edge_offsets_[around.position[e[0]] + 1];
   std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
   for (const Index n : surface.vertices) {
+    // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
+    // rigid body (RigidBodies places them all on every rank, after DCR too).
     const std::span<const int> ranks = dec.node_ranks(n);
-    if (!std::binary_search(ranks.begin(), ranks.end(), dec.rank())) continue;
+    const bool touches = std::binary_search(ranks.begin(), ranks.end(), dec.rank());
+    if (touches || model.scene.bodies[model.mesh.node_body[n]].has_rigid_state()) kept_.push_back(n);
+    if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
     if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
+  position_.assign(num_nodes_, -1);
+  renumber(kept_);
 }
 
 ContactPatch::~ContactPatch() = default;
 
 Index ContactPatch::node(Index whole) const {
   const Index n = model_.local_node(whole);
-  SHATTER_ASSERT(n >= 0);
-  return n;
+  SHATTER_ASSERT(n >= 0 && position_[n] >= 0);
+  return position_[n];
 }
+
+int ContactPatch::owner(Index k) const { return dec_.node_owner(nodes_[k]); }
 
 Index ContactPatch::edge(Index a, Index b) const {
   const Index at = around_.position[a];
@@ -85,6 +93,41 @@ Index ContactPatch::surface_primitive(Index q) const {
   return q < nt ? owned_triangles_[q] : surface_.num_triangles() + patch_edges_[q - nt];
 }
 
+namespace {
+
+/// Every node id of `surface` becomes map[id].
+void relabel(ContactSurface& surface, std::span<const Index> map) {
+  for (auto& t : surface.triangles)
+    for (Index& n : t) n = map[n];
+  for (auto& e : surface.edges)
+    for (Index& n : e) n = map[n];
+  for (Index& n : surface.vertices) n = map[n];
+}
+
+}  // namespace
+
+void ContactPatch::renumber(std::vector<Index> nodes) {
+  // Both numberings ascend with the part's (and the whole model's) ids, so the surfaces'
+  // orders (edges a < b, vertices ascending) stay as they are.
+  std::vector<Vec3> x_old(nodes.size()), x_new(nodes.size()), v(nodes.size());
+  for (size_t k = 0; k < nodes.size(); ++k)
+    if (const Index was = position_[nodes[k]]; was >= 0) x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was];
+  for (const Index n : nodes_) position_[n] = -1;
+  for (size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<Index>(k);
+  std::vector<Index> map(nodes_.size());
+  for (size_t k = 0; k < nodes_.size(); ++k) map[k] = position_[nodes_[k]];
+  relabel(owned_, map);
+  nodes_ = std::move(nodes);
+  x_old_ = std::move(x_old), x_new_ = std::move(x_new), v_ = std::move(v);
+  reach_.clear();
+  if (!part_reach_.empty())
+    for (const Index n : nodes_) reach_.push_back(part_reach_[n]);
+  kept_at_.clear();
+  for (const Index n : kept_) kept_at_.push_back(position_[n]);
+  for (int p = 0; p < 3; ++p)
+    if (plans_[p]) plans_[p] = halo_of(lists_[p]);
+}
+
 void ContactPatch::own(std::span<const Index> primitives) {
   const auto nt = static_cast<Index>(surface_.triangles.size());
   const auto total = nt + static_cast<Index>(surface_.edges.size());
@@ -92,7 +135,7 @@ void ContactPatch::own(std::span<const Index> primitives) {
   owned_triangles_.clear();
   owned_edges_.clear();
   owned_mark_.assign(total, 0);
-  owned_ = {};
+  ContactSurface owned;
   for (size_t k = 0; k < primitives.size(); ++k) {
     const Index q = primitives[k];
     SHATTER_REQUIRE(q >= 0 && q < total && (k == 0 || primitives[k - 1] < q),
@@ -100,18 +143,27 @@ void ContactPatch::own(std::span<const Index> primitives) {
     owned_mark_[q] = 1;
     if (q < nt) {
       owned_triangles_.push_back(q);
-      owned_.triangles.push_back(surface_.triangles[q]);
-      owned_.body.push_back(surface_.body[q]);
+      owned.triangles.push_back(surface_.triangles[q]);
+      owned.body.push_back(surface_.body[q]);
     } else {
       owned_edges_.push_back(q - nt);
-      owned_.edges.push_back(surface_.edges[q - nt]);
+      owned.edges.push_back(surface_.edges[q - nt]);
     }
   }
-  add_nodes<3>(owned_.triangles, owned_.vertices);
-  add_nodes<2>(owned_.edges, owned_.vertices);
-  sort_unique(owned_.vertices);
-  for (auto& p : plans_) p.reset();
-  plans_[static_cast<int>(PatchPlan::Owned)] = plan(owned_.vertices, false);
+  add_nodes<3>(owned.triangles, owned.vertices);
+  add_nodes<2>(owned.edges, owned.vertices);
+  sort_unique(owned.vertices);
+  for (int p = 0; p < 3; ++p) plans_[p].reset(), lists_[p] = {};
+  owned_ = {}, patch_ = {}, normals_ = {}, normals_around_ = {};
+  std::vector<Index> nodes = kept_;
+  nodes.insert(nodes.end(), owned.vertices.begin(), owned.vertices.end());
+  sort_unique(nodes);
+  renumber(std::move(nodes));
+  auto& lists = lists_[static_cast<int>(PatchPlan::Owned)];
+  lists = plan(owned.vertices, false);
+  relabel(owned, position_);
+  owned_ = std::move(owned);
+  plans_[static_cast<int>(PatchPlan::Owned)] = halo_of(lists);
 }
 
 void ContactPatch::add_node(Index n, std::vector<Index>& nodes) {
@@ -123,12 +175,11 @@ void ContactPatch::sort_marked(std::vector<Index>& nodes) {
   std::sort(nodes.begin(), nodes.end());
 }
 
-void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-                         std::span<const double> node_reach) {
+void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
   const int ranks = dec_.size(), me = dec_.rank();
-  owned_boxes_ = inflated_boxes(owned_, x_old, x_new, margin, node_reach);
+  owned_boxes_ = inflated_boxes(owned_, x_old_, x_new_, margin, reach_);
   const SweptBoxes& own = owned_boxes_;
-  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, node_reach);
+  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, part_reach_);
   Box mine = empty_box();
   for (const auto* list : {&own.triangles, &own.edges})
     for (const Box& b : *list) {
@@ -146,49 +197,71 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (size_t k = 0; k < owned_edges_.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r]))
-        for (const Index n : owned_.edges[k]) to[r].push_back(model_.whole_node(n));
+        for (const Index n : owned_.edges[k]) to[r].push_back(model_.whole_node(nodes_[n]));
   for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (boxes_overlap(vertex.vertices[k], boxes[r]))
         to[r].push_back(-(model_.whole_node(volume_vertices_.vertices[k]) + 1));
   std::vector<Index> edges(owned_edges_), vertices;
+  auto part = [&](Index whole) {
+    const Index n = model_.local_node(whole);
+    SHATTER_ASSERT(n >= 0);
+    return n;
+  };
   for (const auto& list : dec_.alltoall(to))
     for (size_t at = 0; at < list.size(); ++at)
-      if (list[at] < 0) vertices.push_back(node(-list[at] - 1));
-      else edges.push_back(edge(node(list[at]), node(list[at + 1]))), ++at;
+      if (list[at] < 0) vertices.push_back(part(-list[at] - 1));
+      else edges.push_back(edge(part(list[at]), part(list[at + 1]))), ++at;
   sort_unique(edges);
   sort_unique(vertices);
+  // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
+  // ~7 times, took a third of reach()'s CPU time on the 76 cubes), then those of the
+  // triangles around them, whose normals orient their pairs (activate()).
+  node_mark_.resize(num_nodes_, 0);
+  std::vector<Index> needed;
+  for (const Index t : owned_triangles_)
+    for (const Index n : surface_.triangles[t]) add_node(n, needed);
+  for (const Index e : edges)
+    for (const Index n : surface_.edges[e]) add_node(n, needed);
+  for (const Index n : vertices) add_node(n, needed);
+  std::vector<Index> nodes = needed;
+  for (const Index n : kept_) add_node(n, nodes);
+  for (size_t k = 0, count = needed.size(); k < count; ++k) {
+    const Index p = around_.position[needed[k]];
+    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i)
+      for (const Index n : surface_.triangles[around_.items[i]]) add_node(n, nodes);
+  }
+  for (const Index n : nodes) node_mark_[n] = 0;
+  std::sort(needed.begin(), needed.end());
+  std::sort(nodes.begin(), nodes.end());
+  for (const PatchPlan p : {PatchPlan::Patch, PatchPlan::Active})
+    plans_[static_cast<int>(p)].reset(), lists_[static_cast<int>(p)] = {};
+  normals_ = {}, normals_around_ = {};
+  renumber(std::move(nodes));
   patch_ = {};
   patch_.triangles = owned_.triangles;
   patch_.body = owned_.body;
-  for (const Index e : edges) patch_.edges.push_back(surface_.edges[e]);
-  patch_.vertices = std::move(vertices);
+  for (const Index e : edges) {
+    const auto& [a, b] = surface_.edges[e];
+    patch_.edges.push_back({position_[a], position_[b]});
+  }
+  for (const Index n : vertices) patch_.vertices.push_back(position_[n]);
   patch_edges_ = std::move(edges);
   patch_edge_owned_.resize(patch_edges_.size());
   for (size_t k = 0; k < patch_edges_.size(); ++k) patch_edge_owned_[k] = owns(surface_.num_triangles() + patch_edges_[k]);
-  // The patch's nodes, made unique by marks: sorting the list with its repeats (each node
-  // ~7 times) took a third of reach()'s CPU time on the 76 cubes.
-  node_mark_.resize(num_nodes_, 0);
-  std::vector<Index> needed;
-  for (const auto& t : patch_.triangles)
-    for (const Index n : t) add_node(n, needed);
-  for (const auto& e : patch_.edges)
-    for (const Index n : e) add_node(n, needed);
-  for (const Index n : patch_.vertices) add_node(n, needed);
-  sort_marked(needed);
-  plans_[static_cast<int>(PatchPlan::Patch)] = plan(needed, false);
-  plans_[static_cast<int>(PatchPlan::Active)].reset();
+  auto& lists = lists_[static_cast<int>(PatchPlan::Patch)];
+  lists = plan(needed, false);
+  plans_[static_cast<int>(PatchPlan::Patch)] = halo_of(lists);
 }
 
-SweptBoxes ContactPatch::patch_boxes(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-                                     std::span<const double> node_reach) const {
+SweptBoxes ContactPatch::patch_boxes(double margin) const {
   // The ghost edges' boxes and the vertices' are new; the owned triangles (all of the
   // patch's) and edges keep those of reach().
   ContactSurface rest;
   for (size_t k = 0; k < patch_.edges.size(); ++k)
     if (!patch_edge_owned_[k]) rest.edges.push_back(patch_.edges[k]);
   rest.vertices = patch_.vertices;
-  SweptBoxes boxes = inflated_boxes(rest, x_old, x_new, margin, node_reach);
+  SweptBoxes boxes = inflated_boxes(rest, x_old_, x_new_, margin, reach_);
   std::vector<Box> ghost_edges = std::move(boxes.edges);
   boxes.triangles = owned_boxes_.triangles;
   boxes.edges.resize(patch_.edges.size());
@@ -199,59 +272,83 @@ SweptBoxes ContactPatch::patch_boxes(std::span<const Vec3> x_old, std::span<cons
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (marks kept between searches, cleared after use).
+  // (marks kept between searches, cleared after use); part node ids.
   triangle_mark_.resize(surface_.triangles.size(), 0);
   node_mark_.resize(num_nodes_, 0);
-  std::vector<Index> needed;
+  std::vector<Index> needed, triangles;
   for (const ContactPair& p : pairs)
-    for (const Index n : p.nodes) add_node(n, needed);
-  normal_triangles_.clear();
-  for (size_t k = 0, nodes = needed.size(); k < nodes; ++k) {
+    for (const Index k : p.nodes) add_node(nodes_[k], needed);
+  for (size_t k = 0, count = needed.size(); k < count; ++k) {
     const Index p = around_.position[needed[k]];
     for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i) {
       const Index t = around_.items[i];
-      if (!triangle_mark_[t]) triangle_mark_[t] = 1, normal_triangles_.push_back(t);
+      if (!triangle_mark_[t]) triangle_mark_[t] = 1, triangles.push_back(t);
     }
   }
-  for (const Index t : normal_triangles_) {
+  for (const Index t : triangles) {
     triangle_mark_[t] = 0;
     for (const Index n : surface_.triangles[t]) add_node(n, needed);
   }
   sort_marked(needed);
-  std::sort(normal_triangles_.begin(), normal_triangles_.end());
-  plans_[static_cast<int>(PatchPlan::Active)] = plan(needed, true);
+  std::sort(triangles.begin(), triangles.end());
+  // reach() holds the triangles around the patch's nodes in the patch. Only the triangles,
+  // their vertices and the vertex -> triangle lists are made (surface_normal's needs).
+  normals_ = {};
+  std::vector<char> vertex(nodes_.size(), 0);
+  for (const Index t : triangles) {
+    const auto& [a, b, c] = surface_.triangles[t];
+    normals_.triangles.push_back({position_[a], position_[b], position_[c]});
+    normals_.body.push_back(surface_.body[t]);
+    for (const Index n : normals_.triangles.back()) vertex[n] = 1;
+  }
+  for (size_t k = 0; k < vertex.size(); ++k)
+    if (vertex[k]) normals_.vertices.push_back(static_cast<Index>(k));
+  normals_around_ = vertex_triangles(normals_);
+  auto& lists = lists_[static_cast<int>(PatchPlan::Active)];
+  lists = plan(needed, true);
+  plans_[static_cast<int>(PatchPlan::Active)] = halo_of(lists);
   active_fresh_ = true;
 }
 
-std::unique_ptr<Halo> ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {
+ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {
   const int ranks = dec_.size(), me = dec_.rank();
-  std::map<int, std::vector<Index>> receive;
+  PlanLists lists;
   std::vector<std::vector<Index>> requests(ranks);
   for (const Index n : nodes) {
     const int owner = dec_.node_owner(n);
     if (owner == me) continue;
-    receive[owner].push_back(n);
+    lists.receive[owner].push_back(n);
     requests[owner].push_back(model_.whole_node(n));
   }
-  std::map<int, std::vector<Index>> send;
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
-    for (const Index whole : asked[r]) send[r].push_back(node(whole));
-  if (readers) find_readers(send, receive);
-  return std::make_unique<Halo>(num_nodes_, exchange_from(send), exchange_from(receive), dec_.comm(), kPatchTag);
+    for (const Index whole : asked[r]) {
+      const Index n = model_.local_node(whole);
+      SHATTER_ASSERT(n >= 0);
+      lists.send[r].push_back(n);
+    }
+  if (readers) find_readers(lists);
+  return lists;
 }
 
-void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,
-                                const std::map<int, std::vector<Index>>& receive) {
+std::unique_ptr<Halo> ContactPatch::halo_of(const PlanLists& lists) const {
+  std::map<int, std::vector<Index>> receive;
+  for (const auto& [r, list] : lists.receive)
+    for (const Index n : list) receive[r].push_back(position_[n]);
+  return std::make_unique<Halo>(num_nodes_, num_nodes(), exchange_from(lists.send), exchange_from(receive),
+                                dec_.comm(), kPatchTag);
+}
+
+void ContactPatch::find_readers(const PlanLists& lists) {
   const int me = dec_.rank();
   neighbors_ = touching_;
-  for (const auto* plan : {&send, &receive})
+  for (const auto* plan : {&lists.send, &lists.receive})
     for (const auto& [r, list] : *plan) neighbors_.push_back(r);
   sort_unique(neighbors_);
   // Each home node's readers: the ranks it is sent to, and the other ranks touching it.
   const auto& home = volume_vertices_.vertices;
   std::vector<std::vector<int>> readers(home.size());
-  for (const auto& [r, list] : send)
+  for (const auto& [r, list] : lists.send)
     for (const Index n : list) readers[std::lower_bound(home.begin(), home.end(), n) - home.begin()].push_back(r);
   reader_offsets_.assign(1, 0);
   readers_.clear();
@@ -266,23 +363,40 @@ void ContactPatch::find_readers(const std::map<int, std::vector<Index>>& send,
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
-long ContactPatch::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
+void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v) {
+  x_old_ = x_new_;
+  for (size_t i = 0; i < kept_.size(); ++i) {
+    const Index n = kept_[i], k = kept_at_[i];
+    x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n];
+  }
+}
+
+void ContactPatch::store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
+  for (size_t i = 0; i < kept_.size(); ++i) {
+    const Index n = kept_[i], k = kept_at_[i];
+    x_old[n] = x_old_[k], x_new[n] = x_new_[k], v[n] = v_[k];
+  }
+}
+
+long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+                            PatchPlan plan) {
   Halo* h = halo(plan);
   if (!h) return 0;
   const bool states_only = plan == PatchPlan::Active && !active_fresh_;
   if (plan == PatchPlan::Active) active_fresh_ = false;
-  const std::span<Vec3> all[] = {x_old, x_new, v};
-  const std::span<const std::span<Vec3>> arrays = states_only ? std::span(all).subspan(1) : std::span(all);
-  h->update_ghosts(arrays);
-  return static_cast<long>(h->update_bytes(3 * static_cast<int>(arrays.size())));
+  const std::span<const Vec3> from[] = {x_old, x_new, v};
+  const std::span<Vec3> to[] = {x_old_, x_new_, v_};
+  const int skip = states_only ? 1 : 0;
+  h->update(std::span(from).subspan(skip), std::span(to).subspan(skip));
+  return static_cast<long>(h->update_bytes(3 * (3 - skip)));
 }
 
-std::span<const int> ContactPatch::readers(Index node) const {
+std::span<const int> ContactPatch::readers(Index k) const {
   const auto& home = volume_vertices_.vertices;
-  const auto it = std::lower_bound(home.begin(), home.end(), node);
-  SHATTER_ASSERT(it != home.end() && *it == node && reader_offsets_.size() == home.size() + 1);
-  const auto k = it - home.begin();
-  return {readers_.data() + reader_offsets_[k], static_cast<size_t>(reader_offsets_[k + 1] - reader_offsets_[k])};
+  const auto it = std::lower_bound(home.begin(), home.end(), nodes_[k]);
+  SHATTER_ASSERT(it != home.end() && *it == nodes_[k] && reader_offsets_.size() == home.size() + 1);
+  const auto at = it - home.begin();
+  return {readers_.data() + reader_offsets_[at], static_cast<size_t>(reader_offsets_[at + 1] - reader_offsets_[at])};
 }
 
 }  // namespace shatter

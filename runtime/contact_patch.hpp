@@ -9,11 +9,13 @@
 // triangles around them only. The search and DCR run on the
 // patch only; no surface state goes to every rank.
 //
-// The surface's topology (triangles, edges, the vertex -> triangle lists) is
-// still held on every rank: memory that grows with the surface, no traffic.
-// Between ranks, nodes are named by their whole-model ids and edges by their
-// two nodes' (docs/parallel.md "Patches with their own topology", step 1),
-// never by positions in the replicated surface.
+// The patch numbers its nodes itself and holds their states in arrays of its
+// own (docs/parallel.md "Patches with their own topology", step 3): the search
+// and DCR read the part's arrays only for the surface nodes of the part's
+// elements. The surface's topology (triangles, edges, the vertex -> triangle
+// lists) is still held on every rank: memory that grows with the surface, no
+// traffic. Between ranks, nodes are named by their whole-model ids and edges by
+// their two nodes' (step 1), never by positions in the replicated surface.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -46,9 +48,10 @@ class ContactPatch {
  public:
   /// surface, around: the contact surface and its vertex -> triangle lists, held by the
   /// caller for the patch's lifetime (a new surface needs a new patch); model: names the
-  /// nodes (whole ids); num_nodes: the length of the nodal arrays.
+  /// nodes (whole ids); num_nodes: the length of the part's nodal arrays; node_reach: per
+  /// part node, its reach (inflated_boxes; empty without shells), held by the caller.
   ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               const Model& model, Index num_nodes);
+               const Model& model, Index num_nodes, std::span<const double> node_reach = {});
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
@@ -60,68 +63,102 @@ class ContactPatch {
   bool owned_any() const { return owned_once_; }
   /// Whether this rank owns primitive q (numbered as in own()).
   bool owns(Index q) const { return owned_mark_[q] != 0; }
-  /// The triangles and edges owned here (surface indices, ascending) and their nodes.
+  /// The triangles and edges owned here (surface indices, ascending) and their nodes
+  /// (patch node ids).
   std::span<const Index> owned_triangles() const { return owned_triangles_; }
   std::span<const Index> owned_edges() const { return owned_edges_; }
   const ContactSurface& owned() const { return owned_; }
 
-  /// The ghosts for a search over x_old -> x_new with reuse margin `margin` (the owned
-  /// primitives' states must be here): every rank's reach box (the union of its owned
-  /// primitives' inflated boxes) is gathered; the owner of each edge sends it to the ranks
-  /// whose reach its inflated box overlaps, and the volume owner of each vertex likewise.
-  /// The patch becomes the owned triangles, the owned and ghost edges and the vertices that
-  /// reach here; their nodes are PatchPlan::Patch. Collective.
-  /// `node_reach`: per node, its reach (inflated_boxes), empty without shells.
-  void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-             std::span<const double> node_reach = {});
-  /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates)
-  /// and of the triangles around them, whose normals orient the pairs. Collective.
+  /// The ghosts for a search over x_old -> x_new (the part's arrays: its home vertices'
+  /// states; the owned primitives' must be in the patch's) with reuse margin `margin`: every
+  /// rank's reach box (the union of its owned primitives' inflated boxes) is gathered; the
+  /// owner of each edge sends it to the ranks whose reach its inflated box overlaps, and the
+  /// volume owner of each vertex likewise. The patch becomes the owned triangles, the owned
+  /// and ghost edges and the vertices that reach here; their nodes are PatchPlan::Patch.
+  /// Collective.
+  void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
+  /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates,
+  /// patch node ids) and of the triangles around them, whose normals orient the pairs.
+  /// Collective.
   void activate(std::span<const ContactPair> pairs);
-  /// The surface the search runs on here (surface order, node ids of the mesh).
+  /// The surface the search runs on here (surface order, patch node ids).
   const ContactSurface& patch() const { return patch_; }
   /// Per edge of patch(): 1 if owned here (find_owned_candidates keeps their pairs).
   std::span<const std::uint8_t> patch_edges_owned() const { return patch_edge_owned_; }
   /// The patch's inflated boxes for the search (inflated_boxes of patch(), with the owned
   /// primitives' from reach(); their states must be unchanged since, the rest here).
-  SweptBoxes patch_boxes(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin,
-                         std::span<const double> node_reach = {}) const;
+  SweptBoxes patch_boxes(double margin) const;
   /// The primitive (numbered as in own()) of a primitive of patch() (as in OwnedPairs).
   Index surface_primitive(Index patch_primitive) const;
-  /// The triangles whose normals the active pairs read, ascending.
-  std::span<const Index> normal_triangles() const { return normal_triangles_; }
-  /// The surface vertices whose volume owner this rank is, ascending.
+  /// The triangles whose normals the active pairs read (those around their nodes), in
+  /// surface order, and their vertices (no edges), with their vertex -> triangle lists
+  /// (patch node ids).
+  const ContactSurface& normals() const { return normals_; }
+  const VertexTriangles& normals_around() const { return normals_around_; }
+  /// The surface vertices whose volume owner this rank is, ascending (part node ids).
   std::span<const Index> home_vertices() const { return volume_vertices_.vertices; }
 
-  /// The volume owners' x_old, x_new and v of the plan's nodes into the arrays; returns the
-  /// bytes this rank sent. After the first exchange of an active plan, its x_old are not
-  /// sent: a node active in the last step holds here its final x(n+1) of that step (from
-  /// that exchange, or from DCR's settle when a pair moved it), which is this step's x(n).
-  /// Point to point; collective in the plan's ranks. No-op before the plan is made.
-  long exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
+  // The patch's nodes (docs/parallel.md "Patches with their own topology", step 3): the
+  // nodes of its primitives and of the triangles around them, and the surface nodes whose
+  // part rows the time loop keeps (those of the part's elements, and a rigid body's, which
+  // every rank places), numbered in ascending whole id. Their states live in arrays of the
+  // patch's own; the part's arrays are read and written for the kept nodes only.
+  Index num_nodes() const { return static_cast<Index>(nodes_.size()); }
+  /// Patch node k's node in the part.
+  Index part_node(Index k) const { return nodes_[k]; }
+  /// The patch node whose whole id is `whole` (it must be one).
+  Index node(Index whole) const;
+  /// The rank that owns patch node k (its volume owner).
+  int owner(Index k) const;
+  /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
+  std::span<Vec3> x_old() { return x_old_; }
+  std::span<Vec3> x_new() { return x_new_; }
+  std::span<Vec3> v() { return v_; }
+  /// Per patch node: its reach (empty without shells).
+  std::span<const double> node_reach() const { return reach_; }
+  /// A step's start: the part's states of the kept nodes into the patch's; every other
+  /// patch node's x(n) is its x(n+1) of the last step (the time loop's x(n)), which its
+  /// exchange or DCR's settle brought.
+  void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v);
+  /// A step's end: the patch's states of the kept nodes back into the part's arrays.
+  void store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
+
+  /// The volume owners' x_old, x_new and v of the plan's nodes (the part's arrays) into the
+  /// patch's; returns the bytes this rank sent. After the first exchange of an active plan,
+  /// its x_old are not sent (load() sets them). Point to point; collective in the plan's
+  /// ranks. No-op before the plan is made.
+  long exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
   /// states to or receives states from in the last plan (the active one after a search), and
   /// those touching a surface node with it. Empty before the first search.
   std::span<const int> neighbors() const { return neighbors_; }
-  /// The node held here whose whole id is `whole` (every surface node is held here).
-  Index node(Index whole) const;
-  /// For a surface node whose volume owner this rank is: the other ranks that read its
-  /// state (their patches hold it, or they touch it), ascending.
-  std::span<const int> readers(Index node) const;
+  /// For a patch node whose volume owner this rank is: the other ranks that read its state
+  /// (their patches hold it), ascending.
+  std::span<const int> readers(Index k) const;
 
  private:
-  /// Plans the exchange of `nodes` (ascending mesh ids) from their owners; with `readers`,
-  /// makes it the source of neighbors() and readers() (collective).
-  std::unique_ptr<Halo> plan(const std::vector<Index>& nodes, bool readers);
-  /// neighbors() and readers() from a plan's lists: the home nodes `send` gives to each rank,
-  /// and the nodes `receive` takes from each.
-  void find_readers(const std::map<int, std::vector<Index>>& send, const std::map<int, std::vector<Index>>& receive);
+  /// A plan's lists: the home nodes sent to each rank, the nodes received from each (part
+  /// node ids).
+  struct PlanLists {
+    std::map<int, std::vector<Index>> send, receive;
+  };
+  /// Plans the exchange of `nodes` (ascending part node ids) from their owners; with
+  /// `readers`, makes it the source of neighbors() and readers() (collective).
+  PlanLists plan(const std::vector<Index>& nodes, bool readers);
+  /// The Halo of a plan's lists, received into the patch's numbering.
+  std::unique_ptr<Halo> halo_of(const PlanLists& lists) const;
+  /// neighbors() and readers() from a plan's lists.
+  void find_readers(const PlanLists& lists);
   Halo* halo(PatchPlan plan) const;
+  /// The patch's nodes become `nodes` (ascending part node ids; the kept ones among them):
+  /// states kept for the nodes that stay, the primitives' ids and the plans renumbered.
+  void renumber(std::vector<Index> nodes);
   /// Appends node n to `nodes` unless marked, and marks it.
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
-  /// The surface index of the edge {a, b} (a < b, node ids here).
+  /// The surface index of the edge {a, b} (a < b, part node ids).
   Index edge(Index a, Index b) const;
 
   const Decomposition& dec_;
@@ -129,8 +166,10 @@ class ContactPatch {
   const VertexTriangles& around_;
   const Model& model_;
   Index num_nodes_;
+  std::span<const double> part_reach_;
   std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
+  std::vector<Index> kept_;  ///< the surface vertices whose part rows the time loop keeps (load()), part node ids
   bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;
   std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
@@ -138,10 +177,17 @@ class ContactPatch {
   SweptBoxes owned_boxes_;                  ///< inflated boxes of owned_ at the last reach()
   std::vector<Index> patch_edges_;          ///< per edge of patch_: its surface index
   std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
-  std::vector<Index> normal_triangles_;
+  ContactSurface normals_;
+  VertexTriangles normals_around_;
   std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach() and activate(), 0 between calls
-  std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan
+  PlanLists lists_[3];              ///< per PatchPlan
+  std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
+  std::vector<Index> nodes_;        ///< per patch node: its part node, ascending
+  std::vector<Index> position_;     ///< per part node: its patch node, -1 if none
+  std::vector<Index> kept_at_;      ///< per kept_: its patch node
+  std::vector<Vec3> x_old_, x_new_, v_;
+  std::vector<double> reach_;
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks
   std::vector<Index> reader_offsets_;  ///< CSR over volume_vertices_.vertices

@@ -106,7 +106,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   if (by_body()) node_body_ = mesh.node_body;
   if (!dec_) return;
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, model_, mesh.num_nodes());
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, model_, mesh.num_nodes(), reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, model_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
@@ -146,7 +146,8 @@ void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::spa
   ++profile_.searches;
 }
 
-void ContactStage::exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan) {
+void ContactStage::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+                            PatchPlan plan) {
   const auto t0 = std::chrono::steady_clock::now();
   const long bytes = patch_->exchange(x_old, x_new, v, plan);
   profile_.exchange_bytes += bytes;
@@ -177,22 +178,22 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Owned);
   for (bool repartitioned = false;; repartitioned = true) {
     if (repartition_) {
-      patch_->own(partition(x_new));
+      patch_->own(partition());
       exchange(x_old, x_new, v, PatchPlan::Owned);
       repartition_ = false;
       ++profile_.repartitions;
     }
-    patch_->reach(x_old, x_new, margin_, reach_);
+    patch_->reach(x_old, x_new, margin_);
     exchange(x_old, x_new, v, PatchPlan::Patch);
     const double cpu0 = thread_cpu_seconds();
     // The pairs of this rank's primitives (the patch's triangles are all its own; the pairs of
     // a ghost first edge are another rank's), counted per primitive (the weights).
-    const OwnedPairs found = find_owned_candidates(
-        patch_->patch(), patch_->patch_boxes(x_old, x_new, margin_, reach_), patch_->patch_edges_owned());
+    const OwnedPairs found =
+        find_owned_candidates(patch_->patch(), patch_->patch_boxes(margin_), patch_->patch_edges_owned());
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
     for (size_t k = 0; k < found.pairs.size(); ++k) {
-      if (excluded(found.pairs[k])) continue;
+      if (excluded(part_pair(found.pairs[k]))) continue;
       pairs_.push_back(found.pairs[k]);
       weight_[patch_->surface_primitive(found.primitive[k])] += 1.0f;
     }
@@ -206,23 +207,44 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
-std::vector<Index> ContactStage::partition(std::span<const Vec3> x) {
+std::vector<Index> ContactStage::partition() {
   const auto nt = static_cast<Index>(surface_.triangles.size());
+  const ContactSurface& owned = patch_->owned();
+  const std::span<const Vec3> x = patch_->x_new();
   std::vector<Index> ids;
   std::vector<Vec3> points;
   std::vector<float> weights;
-  for (const Index t : patch_->owned_triangles()) {
-    const auto& n = surface_.triangles[t];
-    ids.push_back(t);
+  for (size_t k = 0; k < owned.triangles.size(); ++k) {
+    const auto& n = owned.triangles[k];
+    ids.push_back(patch_->owned_triangles()[k]);
     points.push_back((x[n[0]] + x[n[1]] + x[n[2]]) / 3.0);
   }
-  for (const Index e : patch_->owned_edges()) {
-    const auto& n = surface_.edges[e];
-    ids.push_back(nt + e);
+  for (size_t k = 0; k < owned.edges.size(); ++k) {
+    const auto& n = owned.edges[k];
+    ids.push_back(nt + patch_->owned_edges()[k]);
     points.push_back(0.5 * (x[n[0]] + x[n[1]]));
   }
   for (const Index q : ids) weights.insert(weights.end(), {1.0f, 0.01f + weight_[q]});
   return partition_->partition(ids, points, weights, static_cast<Index>(weight_.size()));
+}
+
+ContactStage::PatchNodeData ContactStage::patch_data(std::span<const double> inv_mass,
+                                                    std::span<const std::uint8_t> held,
+                                                    const DcrRigidBodies* rigid) const {
+  PatchNodeData data;
+  const Index n = patch_->num_nodes();
+  data.inv_mass.resize(n);
+  for (Index k = 0; k < n; ++k) data.inv_mass[k] = inv_mass[patch_->part_node(k)];
+  if (!held.empty()) {
+    data.held.resize(n);
+    for (Index k = 0; k < n; ++k) data.held[k] = held[patch_->part_node(k)];
+  }
+  if (rigid) {
+    data.rigid_body.resize(n);
+    for (Index k = 0; k < n; ++k) data.rigid_body[k] = rigid->node_body[patch_->part_node(k)];
+    data.rigid = {data.rigid_body, rigid->bodies};
+  }
+  return data;
 }
 
 ContactBalance ContactStage::balance() const {
@@ -248,16 +270,20 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   constexpr size_t kWords = 5 + 12;
   std::vector<double> out;
   if (mine) {
+    const std::span<const Vec3> at = patch_->x_new();
     out.push_back(mine->kind);
-    for (const Index n : mine->nodes) out.push_back(model_.whole_node(n));
-    for (const Index n : mine->nodes) out.insert(out.end(), x[n].data(), x[n].data() + 3);
+    for (const Index k : mine->nodes) out.push_back(model_.whole_node(patch_->part_node(k)));
+    for (const Index k : mine->nodes) out.insert(out.end(), at[k].data(), at[k].data() + 3);
   }
   const std::vector<double> all = dec_->allgather(out);
   std::optional<ContactPair> first;
   size_t at_first = 0;
   for (size_t at = 0; at < all.size(); at += kWords) {
     ContactPair p{static_cast<ContactPair::Kind>(all[at]), {}};
-    for (int c = 0; c < 4; ++c) p.nodes[c] = patch_->node(static_cast<Index>(all[at + 1 + c]));
+    for (int c = 0; c < 4; ++c) {
+      p.nodes[c] = model_.local_node(static_cast<Index>(all[at + 1 + c]));
+      SHATTER_ASSERT(p.nodes[c] >= 0);
+    }
     if (!first || p < *first) first = p, at_first = at;
   }
   // Its nodes' positions here too, for the diagnosis.
@@ -269,8 +295,13 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
 ContactPairs ContactStage::active_pairs() const {
   const std::vector<Index>& kept = scratch_.overlapping;
   ContactPairs out(kept.size());
-  for (size_t k = 0; k < kept.size(); ++k) out[k] = pairs_[kept[k]];
+  for (size_t k = 0; k < kept.size(); ++k) out[k] = dec_ ? part_pair(pairs_[kept[k]]) : pairs_[kept[k]];
   return out;
+}
+
+ContactPair ContactStage::part_pair(ContactPair p) const {
+  for (Index& n : p.nodes) n = patch_->part_node(n);
+  return p;
 }
 
 DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
@@ -286,21 +317,24 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   };
   // The reuse check reads the owned surface vertices; the candidates' states come after it
   // (a search brings them itself).
+  if (dec_) patch_->load(x_old, x_new, v);
   const bool valid = candidates_valid(x_old, x_new);
   if (dec_ && valid) exchange(x_old, x_new, v, PatchPlan::Active);
   lap(profile_.verlet_seconds);
   if (!valid) search(x_old, x_new, v);
   lap(profile_.search_seconds);
-  DcrSurface surface{&surface_, &vertex_triangles_};
-  surface.reach = reach_;
-  if (dec_) surface.triangles = patch_->normal_triangles();
   const double cpu0 = thread_cpu_seconds();
   const long bytes0 = dec_ ? ranks_->bytes() : 0, posted0 = dec_ ? ranks_->posted() : 0;
   const double wait0 = dec_ ? ranks_->seconds() : 0, wait_cpu0 = dec_ ? ranks_->cpu_seconds() : 0;
-  DcrResult r =
-      resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, ranks_.get(), held, rigid);
+  DcrResult r;
   double wait_cpu = 0;
   if (dec_) {
+    // DCR on the patch's nodes: their states and what the part knows of them.
+    const PatchNodeData data = patch_data(inv_mass, held, rigid);
+    const DcrSurface surface{&patch_->normals(), &patch_->normals_around(), {}, patch_->node_reach()};
+    r = resolve_contacts(pairs_, patch_->x_new(), patch_->x_old(), patch_->v(), data.inv_mass, dt, options_, surface,
+                         scratch_, ranks_.get(), data.held, rigid ? &data.rigid : nullptr);
+    patch_->store(x_old, x_new, v);
     const long bytes = ranks_->bytes() - bytes0;
     profile_.exchange_bytes += bytes;
     profile_.found_bytes += bytes;
@@ -308,6 +342,9 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     profile_.exchange_seconds += ranks_->seconds() - wait0;
     wait_cpu = ranks_->cpu_seconds() - wait_cpu0;
     if (r.capped) r.unresolved = first_unresolved(r.unresolved, x_new);
+  } else {
+    const DcrSurface surface{&surface_, &vertex_triangles_, {}, reach_};
+    r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, nullptr, held, rigid);
   }
   lap(profile_.sweep_seconds);
   profile_.sweep_cpu_seconds += thread_cpu_seconds() - cpu0 - wait_cpu;

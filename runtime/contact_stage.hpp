@@ -144,12 +144,23 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine`; its nodes' x
   /// from the rank that found it are written into x (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine, std::span<Vec3> x) const;
-  /// The primitives owned here after an RCB partition of the owned ones at x, weighted by
-  /// their candidates.
-  std::vector<Index> partition(std::span<const Vec3> x);
+  /// The primitives owned here after an RCB partition of the owned ones at the patch's
+  /// x(n+1), weighted by their candidates.
+  std::vector<Index> partition();
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
-  void exchange(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v, PatchPlan plan);
+  void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
+  /// A pair of patch nodes as the part's nodes.
+  ContactPair part_pair(ContactPair p) const;
+  /// What DCR reads of the patch's nodes besides their states, from the part's arrays.
+  struct PatchNodeData {
+    std::vector<double> inv_mass;
+    std::vector<std::uint8_t> held;
+    std::vector<std::int32_t> rigid_body;
+    DcrRigidBodies rigid;
+  };
+  PatchNodeData patch_data(std::span<const double> inv_mass, std::span<const std::uint8_t> held,
+                           const DcrRigidBodies* rigid) const;
 
   const Model& model_;
   ContactSurface surface_;

@@ -17,16 +17,26 @@ std::span<const double> as_doubles(std::span<const Vec3> v) {
 }  // namespace
 
 Halo::Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm, int tag)
-    : comm_(comm), tag_(tag), num_nodes_(num_nodes), send_(send), recv_(receive) {}
+    : Halo(num_nodes, num_nodes, send, receive, comm, tag) {}
+
+Halo::Halo(Index send_nodes, Index receive_nodes, const NodeExchange& send, const NodeExchange& receive,
+           MPI_Comm comm, int tag)
+    : comm_(comm), tag_(tag), num_nodes_(send_nodes), num_receive_nodes_(receive_nodes), send_(send),
+      recv_(receive) {}
 
 Halo::~Halo() {
   if (pending_) wait();
 }
 
-void Halo::check(std::span<const double> values, int components, bool expect_pending) const {
-  SHATTER_REQUIRE(components >= 1 && values.size() == static_cast<size_t>(num_nodes_) * components,
-                  "Halo: nodal array of " << values.size() << " doubles for " << num_nodes_ << " nodes x " << components
+void Halo::check_size(size_t size, Index nodes, int components) {
+  SHATTER_REQUIRE(components >= 1 && size == static_cast<size_t>(nodes) * components,
+                  "Halo: nodal array of " << size << " doubles for " << nodes << " nodes x " << components
                                           << " components");
+}
+
+void Halo::check(std::span<const double> values, int components, bool expect_pending) const {
+  SHATTER_REQUIRE(num_nodes_ == num_receive_nodes_, "Halo: an update in place on a plan between two numberings");
+  check_size(values.size(), num_nodes_, components);
   SHATTER_REQUIRE(pending_ == expect_pending, "Halo: " << (pending_ ? "begin_update while an update is pending"
                                                                     : "end_update without a begin_update"));
 }
@@ -86,15 +96,23 @@ void Halo::update_ghosts(std::span<Vec3> values) {
 }
 
 void Halo::update_ghosts(std::span<const std::span<Vec3>> arrays) {
-  for (const auto& a : arrays) check(as_doubles(a), 3, false);
-  const size_t c = 3 * arrays.size();
+  std::vector<std::span<const Vec3>> from(arrays.begin(), arrays.end());
+  update(from, arrays);
+}
+
+void Halo::update(std::span<const std::span<const Vec3>> from, std::span<const std::span<Vec3>> to) {
+  SHATTER_REQUIRE(from.size() == to.size() && !pending_, "Halo: " << from.size() << " arrays into " << to.size()
+                                                                  << (pending_ ? " while an update is pending" : ""));
+  for (const auto& a : from) check_size(3 * a.size(), num_nodes_, 3);
+  for (const auto& a : to) check_size(3 * a.size(), num_receive_nodes_, 3);
+  const size_t c = 3 * from.size();
   send_buffer_.resize(send_.nodes.size() * c);
   for (size_t p = 0; p < send_.nodes.size(); ++p)
-    for (size_t k = 0; k < arrays.size(); ++k) std::copy_n(arrays[k][send_.nodes[p]].data(), 3, &send_buffer_[p * c + 3 * k]);
+    for (size_t k = 0; k < from.size(); ++k) std::copy_n(from[k][send_.nodes[p]].data(), 3, &send_buffer_[p * c + 3 * k]);
   post(static_cast<int>(c));
   wait();
   for (size_t p = 0; p < recv_.nodes.size(); ++p)
-    for (size_t k = 0; k < arrays.size(); ++k) std::copy_n(&recv_buffer_[p * c + 3 * k], 3, arrays[k][recv_.nodes[p]].data());
+    for (size_t k = 0; k < to.size(); ++k) std::copy_n(&recv_buffer_[p * c + 3 * k], 3, to[k][recv_.nodes[p]].data());
 }
 
 }  // namespace shatter

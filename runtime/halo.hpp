@@ -43,6 +43,10 @@ class Halo {
   /// exchange apart from the others' on it; the ranks run the updates of one
   /// tag in the same order.
   Halo(Index num_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm, int tag);
+  /// A plan between two numberings (update()): `send` indexes arrays of `send_nodes`
+  /// nodes, `receive` arrays of `receive_nodes`.
+  Halo(Index send_nodes, Index receive_nodes, const NodeExchange& send, const NodeExchange& receive, MPI_Comm comm,
+       int tag);
   ~Halo();
   Halo(const Halo&) = delete;
   Halo& operator=(const Halo&) = delete;
@@ -58,6 +62,9 @@ class Halo {
   void update_ghosts(std::span<Vec3> values);
   /// update_ghosts of several arrays in one message per rank.
   void update_ghosts(std::span<const std::span<Vec3>> arrays);
+  /// The same from one set of arrays into another (the constructor's two numberings):
+  /// the send lists' entries of `from[k]` go into the receive lists' entries of `to[k]`.
+  void update(std::span<const std::span<const Vec3>> from, std::span<const std::span<Vec3>> to);
 
   /// Bytes this rank sends per update of `components` doubles per node.
   std::size_t update_bytes(int components) const { return send_.nodes.size() * components * sizeof(double); }
@@ -66,13 +73,15 @@ class Halo {
 
  private:
   void check(std::span<const double> values, int components, bool expect_pending) const;
+  /// Whether arrays of `size` doubles hold `nodes` nodes of `components` (else Error).
+  static void check_size(size_t size, Index nodes, int components);
   void wait();
   /// Post the receives and the sends of send_buffer_, `components` doubles per node.
   void post(int components);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int tag_ = 0;
-  Index num_nodes_ = 0;
+  Index num_nodes_ = 0, num_receive_nodes_ = 0;
   NodeExchange send_, recv_;
   std::vector<double> send_buffer_, recv_buffer_;
   std::vector<MPI_Request> requests_;

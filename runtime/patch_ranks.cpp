@@ -24,7 +24,7 @@ int rank_of(std::uint64_t w) { return static_cast<int>(w) - 1; }
 }  // namespace
 
 PatchRanks::PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec)
-    : patch_(patch), model_(model), dec_(dec), rank_(dec.rank()) {
+    : patch_(patch), model_(model), rank_(dec.rank()) {
   MPI_Comm_dup(dec.comm(), &comm_);
 }
 
@@ -33,7 +33,9 @@ PatchRanks::~PatchRanks() {
   if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
 }
 
-std::uint64_t PatchRanks::id(Index node) const { return static_cast<std::uint64_t>(model_.whole_node(node)); }
+std::uint64_t PatchRanks::id(Index node) const {
+  return static_cast<std::uint64_t>(model_.whole_node(patch_.part_node(node)));
+}
 
 long PatchRanks::total(long count) {
   timed(seconds_, cpu_seconds_, [&] { MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG, MPI_SUM, comm_); });
@@ -76,7 +78,7 @@ void PatchRanks::link(std::vector<DcrLink>& links) {
     for (size_t k = 0; k < links.size(); ++k) {
       const auto n = static_cast<Index>(links[k].node);
       const std::uint64_t whole = id(n);
-      const int owner = dec_.node_owner(n);
+      const int owner = patch_.owner(n);
       if (owner == rank_) {
         home.push_back({whole, links[k].key, rank_, k});
         continue;
@@ -166,7 +168,7 @@ std::vector<Index> PatchRanks::settle(std::span<const Index> last, std::span<Vec
     std::vector<Words> out(neighbors.size());
     std::vector<std::pair<Index, int>> settled;  // (node owned here, the rank that resolved its last pair)
     for (const Index n : last) {
-      const int owner = dec_.node_owner(n);
+      const int owner = patch_.owner(n);
       if (owner == rank_) settled.emplace_back(n, rank_);
       else append(out[neighbor(owner)], n, x_new[n], v[n]);
     }

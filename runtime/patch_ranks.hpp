@@ -26,8 +26,8 @@ struct Model;
 
 class PatchRanks final : public DcrRanks {
  public:
-  /// The patch must outlive this. Between ranks nodes are named by their whole ids (model).
-  /// Collective (duplicates the communicator).
+  /// The patch must outlive this. Nodes are the patch's (ContactPatch::num_nodes()); between
+  /// ranks they are named by their whole ids (model). Collective (duplicates the communicator).
   PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec);
   ~PatchRanks() override;
   PatchRanks(const PatchRanks&) = delete;
@@ -59,7 +59,6 @@ class PatchRanks final : public DcrRanks {
 
   const ContactPatch& patch_;
   const Model& model_;
-  const Decomposition& dec_;
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
   std::vector<Words> sending_;  ///< posts in flight
