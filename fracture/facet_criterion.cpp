@@ -164,8 +164,8 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         candidate[count] = f;
         count += keep;
       }
-      // Their corners and elements, in a loop of independent loads (the
-      // misses on conn overlap), then the tractions kFacetLanes at a time.
+      // Their corners and elements (the conn rows of the elements 0, in
+      // order), then the tractions kFacetLanes at a time.
       for (int k = 0; k < count; ++k) {
         const Index f = candidate[k];
         const auto [e0, e1] = topo.facet_elem[f];
@@ -174,6 +174,12 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         for (int a = 0; a < 3; ++a) corner_node[a][k] = corner[face[a]];
         side[0][k] = e0;
         side[1][k] = e1;
+        // Element 1's stress row is the one load of the evaluation out of
+        // order (the facets follow their elements 0): ask for it now, so that
+        // its misses overlap here rather than stall the lanes' gathers.
+        const double* row = stress.data() + static_cast<size_t>(e1) * stress_size;
+        __builtin_prefetch(row);
+        __builtin_prefetch(row + stress_size - 1);
       }
       auto evaluate = [&]<int S>() {
         for (int k0 = 0; k0 < count; k0 += kFacetLanes) {
