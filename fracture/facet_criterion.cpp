@@ -162,18 +162,22 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
                           (!owned_flag || owned_flag[std::min(e0, e1_or_e0)]) &
                           (0.5 * (frobenius[e0] + frobenius[e1_or_e0]) * widest >= strength);
         candidate[count] = f;
+        side[0][count] = e0;
+        side[1][count] = e1_or_e0;
         count += keep;
       }
-      // Their corners and elements, in a loop of independent loads (the
-      // misses on conn overlap), then the tractions kFacetLanes at a time.
+      // Their corners (the conn rows of the elements 0, in order), then the
+      // tractions kFacetLanes at a time.
       for (int k = 0; k < count; ++k) {
-        const Index f = candidate[k];
-        const auto [e0, e1] = topo.facet_elem[f];
-        const Index* corner = mesh.element(e0);
-        const std::array<int, 6>& face = kTetFaces[topo.facet_face[f][0]];
+        const Index* corner = mesh.element(side[0][k]);
+        const std::array<int, 6>& face = kTetFaces[topo.facet_face[candidate[k]][0]];
         for (int a = 0; a < 3; ++a) corner_node[a][k] = corner[face[a]];
-        side[0][k] = e0;
-        side[1][k] = e1;
+        // Element 1's stress row is the one load of the evaluation out of
+        // order (the facets follow their elements 0): ask for it now, so
+        // that its misses overlap here rather than stall the lanes' gathers.
+        const double* row = stress.data() + static_cast<size_t>(side[1][k]) * stress_size;
+        __builtin_prefetch(row);
+        __builtin_prefetch(row + stress_size - 1);
       }
       auto evaluate = [&]<int S>() {
         for (int k0 = 0; k0 < count; k0 += kFacetLanes) {
@@ -181,11 +185,13 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
           FacetTractionLanes<kFacetLanes, S> L;
           double strength[kFacetLanes];
           const double* corner_x[3][kFacetLanes];
-          const double* side_stress[2][kFacetLanes];
+          double stress_sum[kFacetLanes][S];  // a facet's sum per row: added as the rows lie in memory
           for (int l = 0; l < kFacetLanes; ++l) {
             const int k = k0 + std::min(l, lanes - 1);  // lanes past the last repeat it
             for (int a = 0; a < 3; ++a) corner_x[a][l] = x[corner_node[a][k]].data();
-            for (int j = 0; j < 2; ++j) side_stress[j][l] = stress.data() + static_cast<size_t>(side[j][k]) * S;
+            const double* s0 = stress.data() + static_cast<size_t>(side[0][k]) * S;
+            const double* s1 = stress.data() + static_cast<size_t>(side[1][k]) * S;
+            for (int q = 0; q < S; ++q) stress_sum[l][q] = s0[q] + s1[q];
             const CohesiveLaw& law = *laws.material[mat[side[0][k]]];  // facet_law's
             L.beta[l] = law.beta;
             strength[l] = laws.facet_strength.empty() ? law.sigma_c : laws.facet_strength[candidate[k]];
@@ -194,9 +200,8 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
           for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c)
               for (int l = 0; l < kFacetLanes; ++l) L.x[3 * a + c][l] = corner_x[a][l][c];
-          for (int j = 0; j < 2; ++j)
-            for (int q = 0; q < S; ++q)
-              for (int l = 0; l < kFacetLanes; ++l) L.stress[j][q][l] = side_stress[j][l][q];
+          for (int q = 0; q < S; ++q)
+            for (int l = 0; l < kFacetLanes; ++l) L.stress_sum[q][l] = stress_sum[l][q];
           // The decisions without division or square root; the tractions
           // themselves only where the margin leaves a lane undecided (rare:
           // t_eff within ~1e-10 of the strength). Lanes past the last repeat it.

@@ -62,14 +62,16 @@ inline constexpr int kVoigtOfRowMajor[9] = {0, 5, 4, 5, 1, 3, 4, 3, 2};
 
 /// N facets side by side (lane l = one facet), struct-of-arrays, for
 /// facet_traction_lanes. S = 6: stresses in Voigt order (xx, yy, zz, yz, xz,
-/// xy); S = 9: row-major, stress[k][3i + j][l] = sigma(i, j).
+/// xy); S = 9: row-major, stress_sum[3i + j][l] = sigma_0(i, j) + sigma_1(i, j).
+/// The kernels read the two stresses only through their sum, so the caller
+/// adds them before filling the lanes (half the rows to fill).
 template <int N, int S>
 struct FacetTractionLanes {
   static_assert(S == 6 || S == 9);
-  double x[9][N];          ///< in: corners a, b, c of the facet, x[3a + i][l], m
-  double stress[2][S][N];  ///< in: Cauchy stresses of its two elements, Pa
-  double beta[N];          ///< in: shear-to-normal weighting of its law
-  double traction[N];      ///< out: effective traction t_eff, Pa
+  double x[9][N];           ///< in: corners a, b, c of the facet, x[3a + i][l], m
+  double stress_sum[S][N];  ///< in: sigma_0 + sigma_1, the sum of its two elements' Cauchy stresses, Pa
+  double beta[N];           ///< in: shear-to-normal weighting of its law
+  double traction[N];       ///< out: effective traction t_eff, Pa
 };
 
 /// (b - a) x (c - a) of lane l's corner triangle, the operations of Eigen's
@@ -107,7 +109,7 @@ inline void facet_traction_lanes(FacetTractionLanes<N, S>& L) {
     n[1][l] = c1 / r;
     n[2][l] = c2 / r;
     double mean[S];
-    for (int q = 0; q < S; ++q) mean[q] = 0.5 * (L.stress[0][q][l] + L.stress[1][q][l]);
+    for (int q = 0; q < S; ++q) mean[q] = 0.5 * L.stress_sum[q][l];
     for (int q = 0; q < 9; ++q) sigma[q][l] = mean[S == 6 ? kVoigtOfRowMajor[q] : q];
   }
   for (int l = 0; l < N; ++l) L.traction[l] = effective_traction_lane(sigma, n, L.beta[l], l);
@@ -137,10 +139,7 @@ inline void facet_criterion_lanes(const FacetTractionLanes<N, S>& L, const doubl
     facet_cross(L, l, c[0], c[1], c[2]);
     const double z = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
     double sum[9];
-    for (int q = 0; q < 9; ++q) {
-      const int k = S == 6 ? kVoigtOfRowMajor[q] : q;
-      sum[q] = L.stress[0][k][l] + L.stress[1][k][l];
-    }
+    for (int q = 0; q < 9; ++q) sum[q] = L.stress_sum[S == 6 ? kVoigtOfRowMajor[q] : q][l];
     const double w0 = sum[0] * c[0] + sum[1] * c[1] + sum[2] * c[2];
     const double w1 = sum[3] * c[0] + sum[4] * c[1] + sum[5] * c[2];
     const double w2 = sum[6] * c[0] + sum[7] * c[1] + sum[8] * c[2];

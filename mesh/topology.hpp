@@ -40,6 +40,10 @@ enum class FacetState : std::uint8_t { intact, cohesive, free };
 ///                    elements and face its local face there: the same on
 ///                    every rank that holds both elements
 ///   elem_facet[4 e + i] = facet of local face i of element e
+/// Facets are numbered in the order of their element 0 (local id), then its
+/// local face: a walk over the facets reads the elements 0 in order (the
+/// facet check, fracture/facet_criterion.cpp). Local facet ids mean nothing
+/// across ranks; facet_gid does.
 struct Topology {
   std::vector<std::array<Index, 2>> facet_elem;
   std::vector<std::array<std::int8_t, 2>> facet_face;

@@ -34,6 +34,10 @@ void check_topology(const Mesh& m) {
     const auto n0 = face_nodes(m, e0, t.facet_face[f][0]);
     EXPECT_GT(facet_area_vector(m, e0, t.facet_face[f][0]).dot(m.reference[n0[0]] - centre), 0);
     EXPECT_EQ(t.elem_facet[4 * e0 + t.facet_face[f][0]], f);
+    // Numbered by element 0, then its local face (the facet check's walk reads the elements 0 in order).
+    if (f > 0) {
+      EXPECT_LT(4 * t.facet_elem[f - 1][0] + t.facet_face[f - 1][0], 4 * e0 + t.facet_face[f][0]);
+    }
     if (e1 < 0) {
       ++boundary;
       boundary_area += facet_area_vector(m, e0, t.facet_face[f][0]).norm();

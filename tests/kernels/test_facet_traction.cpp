@@ -44,12 +44,13 @@ template <int N, int S>
 void set_lane(FacetTractionLanes<N, S>& L, const Facet& f, int l) {
   for (int a = 0; a < 3; ++a)
     for (int i = 0; i < 3; ++i) L.x[3 * a + i][l] = f.x[a][i];
-  for (int k = 0; k < 2; ++k)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        if (S == 9) L.stress[k][3 * i + j][l] = f.sigma[k](i, j);
-        else if (j >= i) L.stress[k][kVoigtOfRowMajor[3 * i + j]][l] = f.sigma[k](i, j);
-      }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      if (S == 9)
+        L.stress_sum[3 * i + j][l] = f.sigma[0](i, j) + f.sigma[1](i, j);
+      else if (j >= i)
+        L.stress_sum[kVoigtOfRowMajor[3 * i + j]][l] = f.sigma[0](i, j) + f.sigma[1](i, j);
+    }
   L.beta[l] = f.beta;
 }
 
@@ -129,8 +130,7 @@ TEST(FacetTraction, UniaxialStressOnAnInclinedFacet) {
                          Vec3(0.01, 0.02, 0.03) + 1e-3 * t2};
       for (int a = 0; a < 3; ++a)
         for (int i = 0; i < 3; ++i) L.x[3 * a + i][0] = x[a][i];
-      for (int k = 0; k < 2; ++k)
-        for (int q = 0; q < 9; ++q) L.stress[k][q][0] = q == 0 ? s * (k == 0 ? 0.5 : 1.5) : 0.0;
+      for (int q = 0; q < 9; ++q) L.stress_sum[q][0] = q == 0 ? s * (0.5 + 1.5) : 0.0;
       L.beta[0] = beta;
       facet_traction_lanes(L);
       const double c = std::cos(theta), sn = std::sin(theta);
@@ -143,7 +143,7 @@ TEST(FacetTraction, AZeroAreaFacetCarriesNoTraction) {
   FacetTractionLanes<2, 9> L;
   for (int l = 0; l < 2; ++l) {
     for (int q = 0; q < 9; ++q) L.x[q][l] = 0.25 * (q % 3) + (l == 1 ? 0.125 * (q / 3) : 0.0);  // exact in binary
-    for (int q = 0; q < 9; ++q) L.stress[0][q][l] = L.stress[1][q][l] = q % 4 == 0 ? 1e9 : 0.0;
+    for (int q = 0; q < 9; ++q) L.stress_sum[q][l] = q % 4 == 0 ? 2e9 : 0.0;
     L.beta[l] = 1.0;
   }
   facet_traction_lanes(L);  // lane 0: three coincident corners; lane 1: collinear ones
@@ -189,7 +189,7 @@ TEST(FacetTraction, CriterionLanesLeaveAZeroAreaFacetUndecided) {
   FacetTractionLanes<2, 9> L;
   for (int l = 0; l < 2; ++l) {
     for (int q = 0; q < 9; ++q) L.x[q][l] = 0.25 * (q % 3) + (l == 1 ? 0.125 * (q / 3) : 0.0);
-    for (int q = 0; q < 9; ++q) L.stress[0][q][l] = L.stress[1][q][l] = q % 4 == 0 ? 1e9 : 0.0;
+    for (int q = 0; q < 9; ++q) L.stress_sum[q][l] = q % 4 == 0 ? 2e9 : 0.0;
     L.beta[l] = 1.0;
   }
   const double strength[2] = {1e6, 1e6};
