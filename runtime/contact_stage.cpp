@@ -104,9 +104,21 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   have_candidates_ = false;
   pairs_.clear();
   if (by_body()) node_body_ = mesh.node_body;
+  surface_nodes_.clear();
   if (!dec_) return;
+  // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
+  // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
+  surface_nodes_ = surface_.vertices;
+  const std::vector<Index>& at = vertex_triangles_.position;
+  for (auto& t : surface_.triangles)
+    for (Index& n : t) n = at[n];
+  for (auto& e : surface_.edges)
+    for (Index& n : e) n = at[n];
+  std::iota(surface_.vertices.begin(), surface_.vertices.end(), 0);
+  vertex_triangles_ = vertex_triangles(surface_);
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, model_, mesh.num_nodes(), reach_);
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, surface_nodes_, model_, mesh.num_nodes(),
+                                          reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, model_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
@@ -170,7 +182,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   if (!patch_->owned_any()) {
     std::vector<Index> first_owned;
     for (Index q = 0; q < nt + static_cast<Index>(surface_.edges.size()); ++q)
-      if (dec_->node_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
+      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
         first_owned.push_back(q);
     patch_->own(first_owned);
   }
