@@ -121,8 +121,13 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   // Both numberings ascend with the part's (and the whole model's) ids, so the surfaces'
   // orders (edges a < b, vertices ascending) stay as they are.
   std::vector<Vec3> x_old(nodes.size()), x_new(nodes.size()), v(nodes.size());
+  std::vector<double> inv_mass(nodes.size(), 0.0);
+  std::vector<std::uint8_t> held(held_.empty() ? 0 : nodes.size(), 0);
   for (size_t k = 0; k < nodes.size(); ++k)
-    if (const Index was = position_[nodes[k]]; was >= 0) x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was];
+    if (const Index was = position_[nodes[k]]; was >= 0) {
+      x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was], inv_mass[k] = inv_mass_[was];
+      if (!held.empty()) held[k] = held_[was];
+    }
   for (const Index n : nodes_) position_[n] = -1;
   for (size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<Index>(k);
   std::vector<Index> map(nodes_.size());
@@ -130,6 +135,7 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   relabel(owned_, map);
   nodes_ = std::move(nodes);
   x_old_ = std::move(x_old), x_new_ = std::move(x_new), v_ = std::move(v);
+  inv_mass_ = std::move(inv_mass), held_ = std::move(held);
   reach_.clear();
   if (!part_reach_.empty())
     for (const Index n : nodes_) reach_.push_back(part_reach_[surface_nodes_[n]]);
@@ -369,11 +375,15 @@ void ContactPatch::find_readers(const PlanLists& lists) {
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
-void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v) {
+void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+                        std::span<const double> inv_mass, std::span<const std::uint8_t> held) {
+  part_inv_mass_ = inv_mass, part_held_ = held;
+  if (!held.empty()) held_.resize(nodes_.size(), 0);
   x_old_ = x_new_;
   for (size_t i = 0; i < kept_.size(); ++i) {
     const Index n = surface_nodes_[kept_[i]], k = kept_at_[i];
-    x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n];
+    x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n], inv_mass_[k] = inv_mass[n];
+    if (!held.empty()) held_[k] = held[n];
   }
 }
 
@@ -390,11 +400,28 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
   if (!h) return 0;
   const bool states_only = plan == PatchPlan::Active && !active_fresh_;
   if (plan == PatchPlan::Active) active_fresh_ = false;
-  const std::span<const Vec3> from[] = {x_old, x_new, v};
-  const std::span<Vec3> to[] = {x_old_, x_new_, v_};
-  const int skip = states_only ? 1 : 0;
-  h->update(std::span(from).subspan(skip), std::span(to).subspan(skip));
-  return static_cast<long>(h->update_bytes(3 * (3 - skip)));
+  // The patch's plan brings what DCR reads of the nodes besides their states, as a fourth
+  // array (the nodes' masses and conditions do not change between searches).
+  std::vector<Vec3> data;
+  const bool with_data = plan == PatchPlan::Patch;
+  if (with_data) {
+    part_data_.resize(num_nodes_);
+    for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].send)
+      for (const Index n : list) part_data_[n] = Vec3(part_inv_mass_[n], part_held_.empty() ? 0 : part_held_[n], 0);
+    data.resize(nodes_.size());
+  }
+  const std::span<const Vec3> from[] = {x_old, x_new, v, part_data_};
+  const std::span<Vec3> to[] = {x_old_, x_new_, v_, data};
+  const size_t skip = states_only ? 1 : 0, count = (with_data ? 4 : 3) - skip;
+  h->update(std::span(from).subspan(skip, count), std::span(to).subspan(skip, count));
+  if (with_data)
+    for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].receive)
+      for (const Index n : list) {
+        const Index k = position_[n];
+        inv_mass_[k] = data[k].x();
+        if (!held_.empty()) held_[k] = static_cast<std::uint8_t>(data[k].y());
+      }
+  return static_cast<long>(h->update_bytes(static_cast<int>(3 * count)));
 }
 
 std::span<const int> ContactPatch::readers(Index k) const {

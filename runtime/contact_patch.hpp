@@ -121,15 +121,23 @@ class ContactPatch {
   std::span<Vec3> v() { return v_; }
   /// Per patch node: its reach (empty without shells).
   std::span<const double> node_reach() const { return reach_; }
-  /// A step's start: the part's states of the kept nodes into the patch's; every other
-  /// patch node's x(n) is its x(n+1) of the last step (the time loop's x(n)), which its
-  /// exchange or DCR's settle brought.
-  void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v);
+  /// Per patch node: its inverse mass and held components (as a number: bit k = component
+  /// k), from the part's arrays for the kept nodes (load()), else from the volume owner with
+  /// the patch's plan (exchange()).
+  std::span<const double> inv_mass() const { return inv_mass_; }
+  std::span<const std::uint8_t> held() const { return held_; }
+  /// A step's start: the part's states, inverse masses and held components (empty: none)
+  /// of the kept nodes into the patch's; every other patch node's x(n) is its x(n+1) of the
+  /// last step (the time loop's x(n)), which its exchange or DCR's settle brought. The
+  /// arrays must stay until the step's exchanges are done.
+  void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+            std::span<const double> inv_mass, std::span<const std::uint8_t> held);
   /// A step's end: the patch's states of the kept nodes back into the part's arrays.
   void store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
 
   /// The volume owners' x_old, x_new and v of the plan's nodes (the part's arrays) into the
-  /// patch's; returns the bytes this rank sent. After the first exchange of an active plan,
+  /// patch's, and with the patch's plan their inverse masses and held components (load()'s
+  /// arrays); returns the bytes this rank sent. After the first exchange of an active plan,
   /// its x_old are not sent (load() sets them). Point to point; collective in the plan's
   /// ranks. No-op before the plan is made.
   long exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
@@ -197,6 +205,11 @@ class ContactPatch {
   std::vector<Index> position_;     ///< per surface vertex: its patch node, -1 if none
   std::vector<Index> kept_at_;      ///< per kept_: its patch node
   std::vector<Vec3> x_old_, x_new_, v_;
+  std::vector<double> inv_mass_;
+  std::vector<std::uint8_t> held_;         ///< empty: no node held
+  std::span<const double> part_inv_mass_;  ///< load()'s
+  std::span<const std::uint8_t> part_held_;
+  std::vector<Vec3> part_data_;  ///< per part node, filled for the patch plan's sends: inverse mass, held, 0
   std::vector<double> reach_;
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks

@@ -156,15 +156,8 @@ class ContactStage {
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
   /// A pair of patch nodes as the part's nodes.
   ContactPair part_pair(ContactPair p) const;
-  /// What DCR reads of the patch's nodes besides their states, from the part's arrays.
-  struct PatchNodeData {
-    std::vector<double> inv_mass;
-    std::vector<std::uint8_t> held;
-    std::vector<std::int32_t> rigid_body;
-    DcrRigidBodies rigid;
-  };
-  PatchNodeData patch_data(std::span<const double> inv_mass, std::span<const std::uint8_t> held,
-                           const DcrRigidBodies* rigid) const;
+  /// Per patch node, its free rigid body (rigid.node_body's), from the part's rows.
+  std::vector<std::int32_t> patch_rigid_bodies(const DcrRigidBodies& rigid) const;
 
   const Model& model_;
   ContactSurface surface_;
