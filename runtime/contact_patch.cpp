@@ -48,37 +48,48 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 }
 
 ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-                           const Model& model, Index num_nodes, std::span<const double> node_reach)
-    : dec_(dec), surface_(surface), around_(around), model_(model), num_nodes_(num_nodes), part_reach_(node_reach) {
+                           std::span<const Index> surface_nodes, const Model& model, Index num_nodes,
+                           std::span<const double> node_reach)
+    : dec_(dec), surface_(surface), around_(around), surface_nodes_(surface_nodes), model_(model),
+      num_nodes_(num_nodes), part_reach_(node_reach) {
+  SHATTER_REQUIRE(surface_nodes.size() == surface.vertices.size(),
+                  "ContactPatch: " << surface_nodes.size() << " nodes for " << surface.vertices.size() << " vertices");
   // The edges are sorted by their first node, so each vertex's are a range.
   edge_offsets_.assign(surface.vertices.size() + 1, 0);
   for (const auto& e : surface.edges) ++edge_offsets_[around.position[e[0]] + 1];
   std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
-  for (const Index n : surface.vertices) {
+  for (Index k = 0; k < surface.num_vertices(); ++k) {
+    const Index n = surface_nodes[k];
+    whole_.push_back(model.whole_node(n));
+    owner_.push_back(dec.node_owner(n));
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
     const std::span<const int> ranks = dec.node_ranks(n);
     const bool touches = std::binary_search(ranks.begin(), ranks.end(), dec.rank());
-    if (touches || model.scene.bodies[model.mesh.node_body[n]].has_rigid_state()) kept_.push_back(n);
+    if (touches || model.scene.bodies[model.mesh.node_body[n]].has_rigid_state()) kept_.push_back(k);
     if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
     if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
-  position_.assign(num_nodes_, -1);
+  position_.assign(surface.num_vertices(), -1);
   renumber(kept_);
 }
 
 ContactPatch::~ContactPatch() = default;
 
-Index ContactPatch::node(Index whole) const {
-  const Index n = model_.local_node(whole);
-  SHATTER_ASSERT(n >= 0 && position_[n] >= 0);
-  return position_[n];
+Index ContactPatch::vertex(Index whole) const {
+  const auto it = std::lower_bound(whole_.begin(), whole_.end(), whole);
+  SHATTER_ASSERT(it != whole_.end() && *it == whole);
+  return static_cast<Index>(it - whole_.begin());
 }
 
-int ContactPatch::owner(Index k) const { return dec_.node_owner(nodes_[k]); }
+Index ContactPatch::node(Index whole) const {
+  const Index k = position_[vertex(whole)];
+  SHATTER_ASSERT(k >= 0);
+  return k;
+}
 
 Index ContactPatch::edge(Index a, Index b) const {
   const Index at = around_.position[a];
@@ -110,8 +121,13 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   // Both numberings ascend with the part's (and the whole model's) ids, so the surfaces'
   // orders (edges a < b, vertices ascending) stay as they are.
   std::vector<Vec3> x_old(nodes.size()), x_new(nodes.size()), v(nodes.size());
+  std::vector<double> inv_mass(nodes.size(), 0.0);
+  std::vector<std::uint8_t> held(held_.empty() ? 0 : nodes.size(), 0);
   for (size_t k = 0; k < nodes.size(); ++k)
-    if (const Index was = position_[nodes[k]]; was >= 0) x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was];
+    if (const Index was = position_[nodes[k]]; was >= 0) {
+      x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was], inv_mass[k] = inv_mass_[was];
+      if (!held.empty()) held[k] = held_[was];
+    }
   for (const Index n : nodes_) position_[n] = -1;
   for (size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<Index>(k);
   std::vector<Index> map(nodes_.size());
@@ -119,9 +135,10 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   relabel(owned_, map);
   nodes_ = std::move(nodes);
   x_old_ = std::move(x_old), x_new_ = std::move(x_new), v_ = std::move(v);
+  inv_mass_ = std::move(inv_mass), held_ = std::move(held);
   reach_.clear();
   if (!part_reach_.empty())
-    for (const Index n : nodes_) reach_.push_back(part_reach_[n]);
+    for (const Index n : nodes_) reach_.push_back(part_reach_[surface_nodes_[n]]);
   kept_at_.clear();
   for (const Index n : kept_) kept_at_.push_back(position_[n]);
   for (int p = 0; p < 3; ++p)
@@ -179,7 +196,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   const int ranks = dec_.size(), me = dec_.rank();
   owned_boxes_ = inflated_boxes(owned_, x_old_, x_new_, margin, reach_);
   const SweptBoxes& own = owned_boxes_;
-  const SweptBoxes vertex = inflated_boxes(volume_vertices_, x_old, x_new, margin, part_reach_);
+  const SweptBoxes home = inflated_boxes(volume_vertices_, x_old, x_new, margin, part_reach_);
   Box mine = empty_box();
   for (const auto* list : {&own.triangles, &own.edges})
     for (const Box& b : *list) {
@@ -197,27 +214,22 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (size_t k = 0; k < owned_edges_.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r]))
-        for (const Index n : owned_.edges[k]) to[r].push_back(model_.whole_node(nodes_[n]));
+        for (const Index n : owned_.edges[k]) to[r].push_back(whole_[nodes_[n]]);
   for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
     for (int r = 0; r < ranks; ++r)
-      if (boxes_overlap(vertex.vertices[k], boxes[r]))
+      if (boxes_overlap(home.vertices[k], boxes[r]))
         to[r].push_back(-(model_.whole_node(volume_vertices_.vertices[k]) + 1));
   std::vector<Index> edges(owned_edges_), vertices;
-  auto part = [&](Index whole) {
-    const Index n = model_.local_node(whole);
-    SHATTER_ASSERT(n >= 0);
-    return n;
-  };
   for (const auto& list : dec_.alltoall(to))
     for (size_t at = 0; at < list.size(); ++at)
-      if (list[at] < 0) vertices.push_back(part(-list[at] - 1));
-      else edges.push_back(edge(part(list[at]), part(list[at + 1]))), ++at;
+      if (list[at] < 0) vertices.push_back(vertex(-list[at] - 1));
+      else edges.push_back(edge(vertex(list[at]), vertex(list[at + 1]))), ++at;
   sort_unique(edges);
   sort_unique(vertices);
   // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
   // ~7 times, took a third of reach()'s CPU time on the 76 cubes), then those of the
   // triangles around them, whose normals orient their pairs (activate()).
-  node_mark_.resize(num_nodes_, 0);
+  node_mark_.resize(surface_.vertices.size(), 0);
   std::vector<Index> needed;
   for (const Index t : owned_triangles_)
     for (const Index n : surface_.triangles[t]) add_node(n, needed);
@@ -272,9 +284,9 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (marks kept between searches, cleared after use); part node ids.
+  // (marks kept between searches, cleared after use); surface vertex ids.
   triangle_mark_.resize(surface_.triangles.size(), 0);
-  node_mark_.resize(num_nodes_, 0);
+  node_mark_.resize(surface_.vertices.size(), 0);
   std::vector<Index> needed, triangles;
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) add_node(nodes_[k], needed);
@@ -315,10 +327,10 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
   PlanLists lists;
   std::vector<std::vector<Index>> requests(ranks);
   for (const Index n : nodes) {
-    const int owner = dec_.node_owner(n);
+    const int owner = owner_[n];
     if (owner == me) continue;
     lists.receive[owner].push_back(n);
-    requests[owner].push_back(model_.whole_node(n));
+    requests[owner].push_back(whole_[n]);
   }
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
@@ -363,17 +375,21 @@ void ContactPatch::find_readers(const PlanLists& lists) {
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
-void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v) {
+void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+                        std::span<const double> inv_mass, std::span<const std::uint8_t> held) {
+  part_inv_mass_ = inv_mass, part_held_ = held;
+  if (!held.empty()) held_.resize(nodes_.size(), 0);
   x_old_ = x_new_;
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = kept_[i], k = kept_at_[i];
-    x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n];
+    const Index n = surface_nodes_[kept_[i]], k = kept_at_[i];
+    x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n], inv_mass_[k] = inv_mass[n];
+    if (!held.empty()) held_[k] = held[n];
   }
 }
 
 void ContactPatch::store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = kept_[i], k = kept_at_[i];
+    const Index n = surface_nodes_[kept_[i]], k = kept_at_[i];
     x_old[n] = x_old_[k], x_new[n] = x_new_[k], v[n] = v_[k];
   }
 }
@@ -384,17 +400,35 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
   if (!h) return 0;
   const bool states_only = plan == PatchPlan::Active && !active_fresh_;
   if (plan == PatchPlan::Active) active_fresh_ = false;
-  const std::span<const Vec3> from[] = {x_old, x_new, v};
-  const std::span<Vec3> to[] = {x_old_, x_new_, v_};
-  const int skip = states_only ? 1 : 0;
-  h->update(std::span(from).subspan(skip), std::span(to).subspan(skip));
-  return static_cast<long>(h->update_bytes(3 * (3 - skip)));
+  // The patch's plan brings what DCR reads of the nodes besides their states, as a fourth
+  // array (the nodes' masses and conditions do not change between searches).
+  std::vector<Vec3> data;
+  const bool with_data = plan == PatchPlan::Patch;
+  if (with_data) {
+    part_data_.resize(num_nodes_);
+    for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].send)
+      for (const Index n : list) part_data_[n] = Vec3(part_inv_mass_[n], part_held_.empty() ? 0 : part_held_[n], 0);
+    data.resize(nodes_.size());
+  }
+  const std::span<const Vec3> from[] = {x_old, x_new, v, part_data_};
+  const std::span<Vec3> to[] = {x_old_, x_new_, v_, data};
+  const size_t skip = states_only ? 1 : 0, count = (with_data ? 4 : 3) - skip;
+  h->update(std::span(from).subspan(skip, count), std::span(to).subspan(skip, count));
+  if (with_data)
+    for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].receive)
+      for (const Index n : list) {
+        const Index k = position_[n];
+        inv_mass_[k] = data[k].x();
+        if (!held_.empty()) held_[k] = static_cast<std::uint8_t>(data[k].y());
+      }
+  return static_cast<long>(h->update_bytes(static_cast<int>(3 * count)));
 }
 
 std::span<const int> ContactPatch::readers(Index k) const {
   const auto& home = volume_vertices_.vertices;
-  const auto it = std::lower_bound(home.begin(), home.end(), nodes_[k]);
-  SHATTER_ASSERT(it != home.end() && *it == nodes_[k] && reader_offsets_.size() == home.size() + 1);
+  const Index n = part_node(k);
+  const auto it = std::lower_bound(home.begin(), home.end(), n);
+  SHATTER_ASSERT(it != home.end() && *it == n && reader_offsets_.size() == home.size() + 1);
   const auto at = it - home.begin();
   return {readers_.data() + reader_offsets_[at], static_cast<size_t>(reader_offsets_[at + 1] - reader_offsets_[at])};
 }

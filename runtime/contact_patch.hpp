@@ -46,12 +46,15 @@ enum class PatchPlan { Owned, Patch, Active };
 
 class ContactPatch {
  public:
-  /// surface, around: the contact surface and its vertex -> triangle lists, held by the
-  /// caller for the patch's lifetime (a new surface needs a new patch); model: names the
-  /// nodes (whole ids); num_nodes: the length of the part's nodal arrays; node_reach: per
-  /// part node, its reach (inflated_boxes; empty without shells), held by the caller.
+  /// surface, around: the contact surface in surface vertex ids (vertex k is the surface's
+  /// k-th node: vertices = 0, 1, ...) and its vertex -> triangle lists; surface_nodes: per
+  /// surface vertex, its node in the part; all three held by the caller for the patch's
+  /// lifetime (a new surface needs a new patch). model: names the nodes (whole ids);
+  /// num_nodes: the length of the part's nodal arrays; node_reach: per part node, its reach
+  /// (inflated_boxes; empty without shells), held by the caller.
   ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               const Model& model, Index num_nodes, std::span<const double> node_reach = {});
+               std::span<const Index> surface_nodes, const Model& model, Index num_nodes,
+               std::span<const double> node_reach = {});
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
@@ -105,26 +108,36 @@ class ContactPatch {
   // patch's own; the part's arrays are read and written for the kept nodes only.
   Index num_nodes() const { return static_cast<Index>(nodes_.size()); }
   /// Patch node k's node in the part.
-  Index part_node(Index k) const { return nodes_[k]; }
+  Index part_node(Index k) const { return surface_nodes_[nodes_[k]]; }
   /// The patch node whose whole id is `whole` (it must be one).
   Index node(Index whole) const;
   /// The rank that owns patch node k (its volume owner).
-  int owner(Index k) const;
+  int owner(Index k) const { return owner_[nodes_[k]]; }
+  /// The volume owner of surface vertex v.
+  int vertex_owner(Index v) const { return owner_[v]; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
   std::span<Vec3> v() { return v_; }
   /// Per patch node: its reach (empty without shells).
   std::span<const double> node_reach() const { return reach_; }
-  /// A step's start: the part's states of the kept nodes into the patch's; every other
-  /// patch node's x(n) is its x(n+1) of the last step (the time loop's x(n)), which its
-  /// exchange or DCR's settle brought.
-  void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v);
+  /// Per patch node: its inverse mass and held components (as a number: bit k = component
+  /// k), from the part's arrays for the kept nodes (load()), else from the volume owner with
+  /// the patch's plan (exchange()).
+  std::span<const double> inv_mass() const { return inv_mass_; }
+  std::span<const std::uint8_t> held() const { return held_; }
+  /// A step's start: the part's states, inverse masses and held components (empty: none)
+  /// of the kept nodes into the patch's; every other patch node's x(n) is its x(n+1) of the
+  /// last step (the time loop's x(n)), which its exchange or DCR's settle brought. The
+  /// arrays must stay until the step's exchanges are done.
+  void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
+            std::span<const double> inv_mass, std::span<const std::uint8_t> held);
   /// A step's end: the patch's states of the kept nodes back into the part's arrays.
   void store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
 
   /// The volume owners' x_old, x_new and v of the plan's nodes (the part's arrays) into the
-  /// patch's; returns the bytes this rank sent. After the first exchange of an active plan,
+  /// patch's, and with the patch's plan their inverse masses and held components (load()'s
+  /// arrays); returns the bytes this rank sent. After the first exchange of an active plan,
   /// its x_old are not sent (load() sets them). Point to point; collective in the plan's
   /// ranks. No-op before the plan is made.
   long exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
@@ -138,12 +151,12 @@ class ContactPatch {
   std::span<const int> readers(Index k) const;
 
  private:
-  /// A plan's lists: the home nodes sent to each rank, the nodes received from each (part
-  /// node ids).
+  /// A plan's lists: the home nodes sent to each rank (part node ids), the nodes received
+  /// from each (surface vertex ids).
   struct PlanLists {
     std::map<int, std::vector<Index>> send, receive;
   };
-  /// Plans the exchange of `nodes` (ascending part node ids) from their owners; with
+  /// Plans the exchange of `nodes` (ascending surface vertex ids) from their owners; with
   /// `readers`, makes it the source of neighbors() and readers() (collective).
   PlanLists plan(const std::vector<Index>& nodes, bool readers);
   /// The Halo of a plan's lists, received into the patch's numbering.
@@ -151,25 +164,30 @@ class ContactPatch {
   /// neighbors() and readers() from a plan's lists.
   void find_readers(const PlanLists& lists);
   Halo* halo(PatchPlan plan) const;
-  /// The patch's nodes become `nodes` (ascending part node ids; the kept ones among them):
+  /// The patch's nodes become `nodes` (ascending surface vertex ids; the kept ones among them):
   /// states kept for the nodes that stay, the primitives' ids and the plans renumbered.
   void renumber(std::vector<Index> nodes);
   /// Appends node n to `nodes` unless marked, and marks it.
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
-  /// The surface index of the edge {a, b} (a < b, part node ids).
+  /// The surface index of the edge {a, b} (a < b, surface vertex ids).
   Index edge(Index a, Index b) const;
+  /// The surface vertex whose whole id is `whole` (it must be one).
+  Index vertex(Index whole) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
   const VertexTriangles& around_;
+  std::span<const Index> surface_nodes_;
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
   std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
-  std::vector<Index> kept_;  ///< the surface vertices whose part rows the time loop keeps (load()), part node ids
+  std::vector<Index> whole_;  ///< per surface vertex: its whole id (ascending)
+  std::vector<int> owner_;    ///< per surface vertex: its volume owner
+  std::vector<Index> kept_;   ///< the surface vertices whose part rows the time loop keeps (load())
   bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;
   std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
@@ -183,10 +201,15 @@ class ContactPatch {
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
-  std::vector<Index> nodes_;        ///< per patch node: its part node, ascending
-  std::vector<Index> position_;     ///< per part node: its patch node, -1 if none
+  std::vector<Index> nodes_;        ///< per patch node: its surface vertex, ascending
+  std::vector<Index> position_;     ///< per surface vertex: its patch node, -1 if none
   std::vector<Index> kept_at_;      ///< per kept_: its patch node
   std::vector<Vec3> x_old_, x_new_, v_;
+  std::vector<double> inv_mass_;
+  std::vector<std::uint8_t> held_;         ///< empty: no node held
+  std::span<const double> part_inv_mass_;  ///< load()'s
+  std::span<const std::uint8_t> part_held_;
+  std::vector<Vec3> part_data_;  ///< per part node, filled for the patch plan's sends: inverse mass, held, 0
   std::vector<double> reach_;
   std::vector<int> touching_;   ///< the ranks touching a surface node with this one
   std::vector<int> neighbors_;  ///< touching_ and the plan's ranks

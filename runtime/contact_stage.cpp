@@ -104,9 +104,21 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   have_candidates_ = false;
   pairs_.clear();
   if (by_body()) node_body_ = mesh.node_body;
+  surface_nodes_.clear();
   if (!dec_) return;
+  // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
+  // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
+  surface_nodes_ = surface_.vertices;
+  const std::vector<Index>& at = vertex_triangles_.position;
+  for (auto& t : surface_.triangles)
+    for (Index& n : t) n = at[n];
+  for (auto& e : surface_.edges)
+    for (Index& n : e) n = at[n];
+  std::iota(surface_.vertices.begin(), surface_.vertices.end(), 0);
+  vertex_triangles_ = vertex_triangles(surface_);
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, model_, mesh.num_nodes(), reach_);
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, surface_nodes_, model_, mesh.num_nodes(),
+                                          reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, model_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
@@ -170,7 +182,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   if (!patch_->owned_any()) {
     std::vector<Index> first_owned;
     for (Index q = 0; q < nt + static_cast<Index>(surface_.edges.size()); ++q)
-      if (dec_->node_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
+      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
         first_owned.push_back(q);
     patch_->own(first_owned);
   }
@@ -228,23 +240,12 @@ std::vector<Index> ContactStage::partition() {
   return partition_->partition(ids, points, weights, static_cast<Index>(weight_.size()));
 }
 
-ContactStage::PatchNodeData ContactStage::patch_data(std::span<const double> inv_mass,
-                                                    std::span<const std::uint8_t> held,
-                                                    const DcrRigidBodies* rigid) const {
-  PatchNodeData data;
-  const Index n = patch_->num_nodes();
-  data.inv_mass.resize(n);
-  for (Index k = 0; k < n; ++k) data.inv_mass[k] = inv_mass[patch_->part_node(k)];
-  if (!held.empty()) {
-    data.held.resize(n);
-    for (Index k = 0; k < n; ++k) data.held[k] = held[patch_->part_node(k)];
-  }
-  if (rigid) {
-    data.rigid_body.resize(n);
-    for (Index k = 0; k < n; ++k) data.rigid_body[k] = rigid->node_body[patch_->part_node(k)];
-    data.rigid = {data.rigid_body, rigid->bodies};
-  }
-  return data;
+std::vector<std::int32_t> ContactStage::patch_rigid_bodies(const DcrRigidBodies& rigid) const {
+  // A rigid body's nodes are kept (ContactPatch): every part that holds one of them holds
+  // its row.
+  std::vector<std::int32_t> body(patch_->num_nodes());
+  for (Index k = 0; k < patch_->num_nodes(); ++k) body[k] = rigid.node_body[patch_->part_node(k)];
+  return body;
 }
 
 ContactBalance ContactStage::balance() const {
@@ -317,7 +318,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   };
   // The reuse check reads the owned surface vertices; the candidates' states come after it
   // (a search brings them itself).
-  if (dec_) patch_->load(x_old, x_new, v);
+  if (dec_) patch_->load(x_old, x_new, v, inv_mass, held);
   const bool valid = candidates_valid(x_old, x_new);
   if (dec_ && valid) exchange(x_old, x_new, v, PatchPlan::Active);
   lap(profile_.verlet_seconds);
@@ -329,11 +330,13 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   DcrResult r;
   double wait_cpu = 0;
   if (dec_) {
-    // DCR on the patch's nodes: their states and what the part knows of them.
-    const PatchNodeData data = patch_data(inv_mass, held, rigid);
+    // DCR on the patch's nodes.
+    std::vector<std::int32_t> rigid_body;
+    DcrRigidBodies patch_rigid;
+    if (rigid) rigid_body = patch_rigid_bodies(*rigid), patch_rigid = {rigid_body, rigid->bodies};
     const DcrSurface surface{&patch_->normals(), &patch_->normals_around(), {}, patch_->node_reach()};
-    r = resolve_contacts(pairs_, patch_->x_new(), patch_->x_old(), patch_->v(), data.inv_mass, dt, options_, surface,
-                         scratch_, ranks_.get(), data.held, rigid ? &data.rigid : nullptr);
+    r = resolve_contacts(pairs_, patch_->x_new(), patch_->x_old(), patch_->v(), patch_->inv_mass(), dt, options_,
+                         surface, scratch_, ranks_.get(), patch_->held(), rigid ? &patch_rigid : nullptr);
     patch_->store(x_old, x_new, v);
     const long bytes = ranks_->bytes() - bytes0;
     profile_.exchange_bytes += bytes;

@@ -108,7 +108,11 @@ class ContactStage {
   void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {},
                std::span<const std::array<Index, 2>> twins = {});
 
+  /// The contact surface: in the mesh's node ids on one rank; on several, in surface vertex
+  /// ids (vertex k is the surface's k-th node, surface_nodes()[k] here).
   const ContactSurface& surface() const { return surface_; }
+  /// The surface's nodes, ascending (mesh node ids).
+  std::span<const Index> surface_nodes() const { return dec_ ? surface_nodes_ : surface_.vertices; }
   /// The candidates of the search in force (on several ranks, this rank's).
   const ContactPairs& candidates() const { return pairs_; }
   /// This rank's pairs that DCR checked in the last apply(): on one rank, equal to the
@@ -152,19 +156,13 @@ class ContactStage {
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
   /// A pair of patch nodes as the part's nodes.
   ContactPair part_pair(ContactPair p) const;
-  /// What DCR reads of the patch's nodes besides their states, from the part's arrays.
-  struct PatchNodeData {
-    std::vector<double> inv_mass;
-    std::vector<std::uint8_t> held;
-    std::vector<std::int32_t> rigid_body;
-    DcrRigidBodies rigid;
-  };
-  PatchNodeData patch_data(std::span<const double> inv_mass, std::span<const std::uint8_t> held,
-                           const DcrRigidBodies* rigid) const;
+  /// Per patch node, its free rigid body (rigid.node_body's), from the part's rows.
+  std::vector<std::int32_t> patch_rigid_bodies(const DcrRigidBodies& rigid) const;
 
   const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
+  std::vector<Index> surface_nodes_;  ///< several ranks: per surface vertex, its node here
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;

@@ -390,7 +390,7 @@ void Simulation::rebuild_contact_surface() {
 
 void Simulation::count_contact_vertices() {
   contact_vertices_.clear();
-  for (const Index i : contact_->surface().vertices)
+  for (const Index i : contact_->surface_nodes())
     if (dec_->owns_node(i)) contact_vertices_.push_back(i);
 }
 
