@@ -23,7 +23,7 @@
 #          default /tmp/john_shah_runs; env STEPS=6 H=8.0e-3 END=1.2e-3
 #          ENDS=1 GAMMAS= SIGMA_C= GC= NICE=15)
 # Output:  bench/results/john_shah_bisect_h<H>.csv (john_shah_gammas_h<H>.csv
-#          with GAMMAS; rewritten each time; one row per
+#          with GAMMAS; _end<END> added for another END; rewritten each time; one row per
 #          run: gamma, crack, time it ran, first fully open element in each
 #          region, crack heights at the end, energy error, end time, wall and
 #          CPU seconds, load average before and after) and the switch
@@ -52,7 +52,7 @@ base="$root/scenes/john_shah_beam_g05.yaml"
 judge="$here/john_shah_crack.py"
 py=/usr/bin/python3
 mkdir -p "$here/results" "$runs/scenes"
-csv="$here/results/john_shah_$([ -n "${GAMMAS:-}" ] && echo gammas || echo bisect)_h$h$mat.csv"
+csv="$here/results/john_shah_$([ -n "${GAMMAS:-}" ] && echo gammas || echo bisect)_h$h$mat$([ "$end" = 1.2e-3 ] || echo "_end$end").csv"
 echo "gamma,h,crack,t_run_ms,notch_first_full_ms,midspan_first_full_ms,notch_height_mm,midspan_height_mm,energy_error,end_ms,wall_s,cpu_s,load_before,load_after" > "$csv"
 
 load() { cut -d' ' -f1 /proc/loadavg; }
