@@ -14,13 +14,16 @@
 # two ends are run and judged with the same criterion (ENDS=0 skips them) and
 # the script fails if either disagrees. GAMMAS="g1 g2 ..." runs only those
 # (no bisection; e.g. H=5.0e-3 GAMMAS="0.7625 0.78" for the mesh check).
+# SIGMA_C (Pa) and GC (J/m^2) replace the scene's strength and fracture energy
+# (another material for the same beam; the run folders and the CSV names then
+# carry _s<SIGMA_C>_g<GC>); unset, the scene's 3.0e6 and 40.0.
 # Run:     bash bench/john_shah_bisect.sh BUILD_DIR [RUN_DIR]
 #          (RUN_DIR keeps every run; a run of the same gamma, H and END
 #          already there is reused;
 #          default /tmp/john_shah_runs; env STEPS=6 H=8.0e-3 END=1.2e-3
-#          ENDS=1 GAMMAS=)
+#          ENDS=1 GAMMAS= SIGMA_C= GC= NICE=15)
 # Output:  bench/results/john_shah_bisect_h<H>.csv (john_shah_gammas_h<H>.csv
-#          with GAMMAS; rewritten each time; one row per
+#          with GAMMAS; _end<END> added for another END; rewritten each time; one row per
 #          run: gamma, crack, time it ran, first fully open element in each
 #          region, crack heights at the end, energy error, end time, wall and
 #          CPU seconds, load average before and after) and the switch
@@ -29,20 +32,27 @@
 #          (6 000 TET4, 25 000 steps) 15 s of CPU, 0.5-1.5 min of wall;
 #          5 mm 1 min of CPU, 2 of wall; 4 mm 2 min of CPU, 3 of wall. The
 #          switch: gamma 0.678-0.683 at 8 mm, 0.641-0.645 at 5 mm,
-#          0.636-0.641 at 4 mm (docs/validation.md).
+#          0.636-0.641 at 4 mm (docs/validation.md). With GC=10.0 (cohesive
+#          length 35 mm instead of 0.14 m): 0.65-0.70 at 8 mm (the zone not
+#          resolved), 0.70-0.725 at 5 and 4 mm (docs/validation.md, "Another
+#          cohesive length"). Under load 10: 5 mm 6-13 min of wall, 4 mm 12-19.
 set -euo pipefail
 build=${1:?usage: john_shah_bisect.sh BUILD_DIR [RUN_DIR]}
 runs=${2:-/tmp/john_shah_runs}
 steps=${STEPS:-6}
 h=${H:-8.0e-3}
 end=${END:-1.2e-3}
+sigma_c=${SIGMA_C:-3.0e6}
+gc=${GC:-40.0}
+mat=""
+[ "$sigma_c" = 3.0e6 ] && [ "$gc" = 40.0 ] || mat="_s${sigma_c}_g${gc}"
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 base="$root/scenes/john_shah_beam_g05.yaml"
 judge="$here/john_shah_crack.py"
 py=/usr/bin/python3
 mkdir -p "$here/results" "$runs/scenes"
-csv="$here/results/john_shah_$([ -n "${GAMMAS:-}" ] && echo gammas || echo bisect)_h$h.csv"
+csv="$here/results/john_shah_$([ -n "${GAMMAS:-}" ] && echo gammas || echo bisect)_h$h$mat$([ "$end" = 1.2e-3 ] || echo "_end$end").csv"
 echo "gamma,h,crack,t_run_ms,notch_first_full_ms,midspan_first_full_ms,notch_height_mm,midspan_height_mm,energy_error,end_ms,wall_s,cpu_s,load_before,load_after" > "$csv"
 
 load() { cut -d' ' -f1 /proc/loadavg; }
@@ -56,8 +66,11 @@ scene() {
       -e "s/center: \[0.0508, 0.007025, 0\]/center: [$x, 0.007025, 0]/" \
       -e "s/element_size: 8.0e-3\$/element_size: $h/" \
       -e "s/^  end: 1.2e-3\$/  end: $end/" \
-      -e "s/^  every: 1000\$/  every: 500/" "$base" > "$out"
-  for want in "name: john_shah_$2" "center: \[$x, 0.007025, 0\]" "element_size: $h" "  end: $end" "  every: 500"; do
+      -e "s/^  every: 1000\$/  every: 500/" \
+      -e "s/^      strength: 3.0e6\$/      strength: $sigma_c/" \
+      -e "s/^      energy: 40.0\$/      energy: $gc/" "$base" > "$out"
+  for want in "name: john_shah_$2" "center: \[$x, 0.007025, 0\]" "element_size: $h" "  end: $end" "  every: 500" \
+      "      strength: $sigma_c" "      energy: $gc"; do
     grep -q "^ *$want" "$out" || { echo "john_shah_bisect: $base changed: could not set '$want'" >&2; exit 1; }
   done
   echo "$out"
@@ -66,7 +79,7 @@ scene() {
 # judge_run GAMMA: run (or reuse) this gamma, add its row to the table, print its crack.
 judge_run() {
   local g=$1 tag dir sc verdict l0
-  tag="g${g}_h${h}_end$end"
+  tag="g${g}_h${h}_end$end$mat"
   dir="$runs/$tag"
   sc=$(scene "$g" "$tag")
   if [ ! -f "$dir/summary.json" ]; then
@@ -75,7 +88,7 @@ judge_run() {
     echo "running gamma $g (h $h) to $end s" >&2
     l0=$(load)
     /usr/bin/time -o "$dir/time.txt" -f "%e %U %S" \
-      nice -n 10 "$build/apps/shatter" run "$sc" --out "$dir" --threads 1 --quiet
+      nice -n "${NICE:-15}" "$build/apps/shatter" run "$sc" --out "$dir" --threads 1 --quiet
     echo "$l0 $(load)" > "$dir/load.txt"
   fi
   # john_shah_crack.py: exit 3 = neither crack runs, 4 = both in the same frame.
@@ -130,4 +143,4 @@ if [ "${ENDS:-1}" = 1 ]; then
   [ "$(judge_run 0.5)" = notch ] || { echo "john_shah_bisect: gamma 0.5 does not give the notch crack" >&2; exit 1; }
   [ "$(judge_run 0.8)" = midspan ] || { echo "john_shah_bisect: gamma 0.8 does not give the mid-span crack" >&2; exit 1; }
 fi
-echo "switch from the notch crack to the mid-span crack between gamma $lo and $hi${none:+ (neither crack runs at gamma$none)} (h $h; experiment: about 0.77)"
+echo "switch from the notch crack to the mid-span crack between gamma $lo and $hi${none:+ (neither crack runs at gamma$none)} (h $h, sigma_c $sigma_c Pa, Gc $gc J/m^2; experiment: about 0.77)"
