@@ -70,7 +70,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
     if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
-    if (dec.node_owner(n) == dec.rank()) volume_vertices_.vertices.push_back(n);
+    if (owner_.back() == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
   position_.assign(surface.num_vertices(), -1);
@@ -214,7 +214,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (size_t k = 0; k < owned_edges_.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r]))
-        for (const Index n : owned_.edges[k]) to[r].push_back(whole_[nodes_[n]]);
+        for (const Index n : owned_.edges[k]) to[r].push_back(whole(n));
   for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (boxes_overlap(home.vertices[k], boxes[r]))

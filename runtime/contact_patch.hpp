@@ -109,8 +109,9 @@ class ContactPatch {
   Index num_nodes() const { return static_cast<Index>(nodes_.size()); }
   /// Patch node k's node in the part.
   Index part_node(Index k) const { return surface_nodes_[nodes_[k]]; }
-  /// The patch node whose whole id is `whole` (it must be one).
+  /// The patch node whose whole id is `whole` (it must be one), and patch node k's whole id.
   Index node(Index whole) const;
+  Index whole(Index k) const { return whole_[nodes_[k]]; }
   /// The rank that owns patch node k (its volume owner).
   int owner(Index k) const { return owner_[nodes_[k]]; }
   /// The volume owner of surface vertex v.

@@ -119,7 +119,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   ranks_.reset();
   patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, surface_nodes_, model_, mesh.num_nodes(),
                                           reach_);
-  ranks_ = std::make_unique<PatchRanks>(*patch_, model_, *dec_);
+  ranks_ = std::make_unique<PatchRanks>(*patch_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
@@ -273,7 +273,7 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   if (mine) {
     const std::span<const Vec3> at = patch_->x_new();
     out.push_back(mine->kind);
-    for (const Index k : mine->nodes) out.push_back(model_.whole_node(patch_->part_node(k)));
+    for (const Index k : mine->nodes) out.push_back(patch_->whole(k));
     for (const Index k : mine->nodes) out.insert(out.end(), at[k].data(), at[k].data() + 3);
   }
   const std::vector<double> all = dec_->allgather(out);

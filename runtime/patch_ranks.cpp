@@ -6,7 +6,6 @@
 #include "kernels/error.hpp"
 #include "runtime/contact_patch.hpp"
 #include "runtime/decomposition.hpp"
-#include "runtime/model.hpp"
 #include "runtime/timed.hpp"
 
 namespace shatter {
@@ -23,8 +22,7 @@ int rank_of(std::uint64_t w) { return static_cast<int>(w) - 1; }
 
 }  // namespace
 
-PatchRanks::PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec)
-    : patch_(patch), model_(model), rank_(dec.rank()) {
+PatchRanks::PatchRanks(const ContactPatch& patch, const Decomposition& dec) : patch_(patch), rank_(dec.rank()) {
   MPI_Comm_dup(dec.comm(), &comm_);
 }
 
@@ -33,9 +31,7 @@ PatchRanks::~PatchRanks() {
   if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
 }
 
-std::uint64_t PatchRanks::id(Index node) const {
-  return static_cast<std::uint64_t>(model_.whole_node(patch_.part_node(node)));
-}
+std::uint64_t PatchRanks::id(Index node) const { return static_cast<std::uint64_t>(patch_.whole(node)); }
 
 long PatchRanks::total(long count) {
   timed(seconds_, cpu_seconds_, [&] { MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG, MPI_SUM, comm_); });

@@ -22,13 +22,13 @@ namespace shatter {
 
 class ContactPatch;
 class Decomposition;
-struct Model;
 
 class PatchRanks final : public DcrRanks {
  public:
   /// The patch must outlive this. Nodes are the patch's (ContactPatch::num_nodes()); between
-  /// ranks they are named by their whole ids (model). Collective (duplicates the communicator).
-  PatchRanks(const ContactPatch& patch, const Model& model, const Decomposition& dec);
+  /// ranks they are named by their whole ids (ContactPatch::whole). Collective (duplicates the
+  /// communicator).
+  PatchRanks(const ContactPatch& patch, const Decomposition& dec);
   ~PatchRanks() override;
   PatchRanks(const PatchRanks&) = delete;
   PatchRanks& operator=(const PatchRanks&) = delete;
@@ -58,7 +58,6 @@ class PatchRanks final : public DcrRanks {
   void append(Words& w, Index node, const Vec3& x_new, const Vec3& v) const;
 
   const ContactPatch& patch_;
-  const Model& model_;
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
   std::vector<Words> sending_;  ///< posts in flight
