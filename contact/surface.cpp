@@ -137,6 +137,15 @@ void add_triangles(ContactSurface& surface, std::span<const SurfaceTriangle> tri
   merge_unique(surface.vertices, vertices);
 }
 
+double median_edge_length(const ContactSurface& surface, std::span<const Vec3> x) {
+  if (surface.edges.empty()) return 0;
+  std::vector<double> lengths;
+  lengths.reserve(surface.edges.size());
+  for (const auto& [a, b] : surface.edges) lengths.push_back((x[a] - x[b]).norm());
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
 VertexTriangles vertex_triangles(const ContactSurface& surface) {
   // A counting sort: the triangles are visited in order, so each vertex's come ascending.
   VertexTriangles out;

@@ -78,6 +78,10 @@ struct VertexTriangles {
 /// The vertex -> triangle CSR of a surface, O(t + v + its largest vertex).
 VertexTriangles vertex_triangles(const ContactSurface& surface);
 
+/// The median length of the surface's edges at `x` (per node id), 0 without edges: the
+/// contact search's length scale (ContactStage::margin).
+double median_edge_length(const ContactSurface& surface, std::span<const Vec3> x);
+
 /// Each triangle's (x1 - x0) x (x2 - x0) at x (m^2) and its length, in surface order:
 /// computed once per configuration (oneTBB), so that surface_normal only adds them.
 struct TriangleNormals {

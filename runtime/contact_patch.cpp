@@ -48,29 +48,29 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 }
 
 ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-                           std::span<const Index> surface_nodes, const Model& model, Index num_nodes,
+                           const SurfaceVertices& vertices, const Model& model, Index num_nodes,
                            std::span<const double> node_reach)
-    : dec_(dec), surface_(surface), around_(around), surface_nodes_(surface_nodes), model_(model),
-      num_nodes_(num_nodes), part_reach_(node_reach) {
-  SHATTER_REQUIRE(surface_nodes.size() == surface.vertices.size(),
-                  "ContactPatch: " << surface_nodes.size() << " nodes for " << surface.vertices.size() << " vertices");
+    : dec_(dec), surface_(surface), around_(around), vertices_(vertices), model_(model), num_nodes_(num_nodes),
+      part_reach_(node_reach) {
+  SHATTER_REQUIRE(vertices.whole.size() == surface.vertices.size(),
+                  "ContactPatch: " << vertices.whole.size() << " nodes for " << surface.vertices.size() << " vertices");
   // The edges are sorted by their first node, so each vertex's are a range.
   edge_offsets_.assign(surface.vertices.size() + 1, 0);
   for (const auto& e : surface.edges) ++edge_offsets_[around.position[e[0]] + 1];
   std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
   for (Index k = 0; k < surface.num_vertices(); ++k) {
-    const Index n = surface_nodes[k];
-    whole_.push_back(model.whole_node(n));
-    owner_.push_back(dec.node_owner(n));
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
-    const std::span<const int> ranks = dec.node_ranks(n);
+    const Index n = vertices.node[k];
+    const std::span<const int> ranks = n < 0 ? std::span<const int>() : dec.node_ranks(n);
     const bool touches = std::binary_search(ranks.begin(), ranks.end(), dec.rank());
-    if (touches || model.scene.bodies[model.mesh.node_body[n]].has_rigid_state()) kept_.push_back(k);
+    const bool rigid = model.scene.bodies[vertices.body[k]].has_rigid_state();
+    SHATTER_ASSERT(n >= 0 || !rigid);
+    if (touches || rigid) kept_.push_back(k);
     if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
-    if (owner_.back() == dec.rank()) volume_vertices_.vertices.push_back(n);
+    if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
   position_.assign(surface.num_vertices(), -1);
@@ -80,9 +80,10 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
 ContactPatch::~ContactPatch() = default;
 
 Index ContactPatch::vertex(Index whole) const {
-  const auto it = std::lower_bound(whole_.begin(), whole_.end(), whole);
-  SHATTER_ASSERT(it != whole_.end() && *it == whole);
-  return static_cast<Index>(it - whole_.begin());
+  const std::vector<Index>& ids = vertices_.whole;
+  const auto it = std::lower_bound(ids.begin(), ids.end(), whole);
+  SHATTER_ASSERT(it != ids.end() && *it == whole);
+  return static_cast<Index>(it - ids.begin());
 }
 
 Index ContactPatch::node(Index whole) const {
@@ -138,7 +139,7 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   inv_mass_ = std::move(inv_mass), held_ = std::move(held);
   reach_.clear();
   if (!part_reach_.empty())
-    for (const Index n : nodes_) reach_.push_back(part_reach_[surface_nodes_[n]]);
+    for (const Index n : nodes_) reach_.push_back(part_reach_[vertices_.node[n]]);
   kept_at_.clear();
   for (const Index n : kept_) kept_at_.push_back(position_[n]);
   for (int p = 0; p < 3; ++p)
@@ -327,10 +328,10 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
   PlanLists lists;
   std::vector<std::vector<Index>> requests(ranks);
   for (const Index n : nodes) {
-    const int owner = owner_[n];
+    const int owner = vertices_.owner[n];
     if (owner == me) continue;
     lists.receive[owner].push_back(n);
-    requests[owner].push_back(whole_[n]);
+    requests[owner].push_back(vertices_.whole[n]);
   }
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
@@ -381,7 +382,7 @@ void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new
   if (!held.empty()) held_.resize(nodes_.size(), 0);
   x_old_ = x_new_;
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = surface_nodes_[kept_[i]], k = kept_at_[i];
+    const Index n = vertices_.node[kept_[i]], k = kept_at_[i];
     x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n], inv_mass_[k] = inv_mass[n];
     if (!held.empty()) held_[k] = held[n];
   }
@@ -389,7 +390,7 @@ void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new
 
 void ContactPatch::store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = surface_nodes_[kept_[i]], k = kept_at_[i];
+    const Index n = vertices_.node[kept_[i]], k = kept_at_[i];
     x_old[n] = x_old_[k], x_new[n] = x_new_[k], v[n] = v_[k];
   }
 }

@@ -40,6 +40,15 @@ struct Model;
 SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
                           double margin, std::span<const double> reach = {});
 
+/// What every rank knows of each vertex of the contact surface (ContactStage holds it;
+/// O(surface), as the topology is): per surface vertex, ascending in whole id.
+struct SurfaceVertices {
+  std::vector<Index> whole;  ///< its node's whole-model id
+  std::vector<Index> node;   ///< its node in the part, -1 when the part does not hold it
+  std::vector<int> owner;    ///< its volume owner
+  std::vector<int> body;     ///< its node's body
+};
+
 /// Which nodes' states ContactPatch::exchange brings: the owned primitives' (own()), the
 /// patch's (reach()) or the candidates' (activate()).
 enum class PatchPlan { Owned, Patch, Active };
@@ -47,13 +56,13 @@ enum class PatchPlan { Owned, Patch, Active };
 class ContactPatch {
  public:
   /// surface, around: the contact surface in surface vertex ids (vertex k is the surface's
-  /// k-th node: vertices = 0, 1, ...) and its vertex -> triangle lists; surface_nodes: per
-  /// surface vertex, its node in the part; all three held by the caller for the patch's
-  /// lifetime (a new surface needs a new patch). model: names the nodes (whole ids);
+  /// k-th node: vertices = 0, 1, ...) and its vertex -> triangle lists; vertices: what is
+  /// known of each surface vertex; all three held by the caller for the patch's lifetime (a
+  /// new surface needs a new patch). model: the part (its nodes' whole ids, its bodies);
   /// num_nodes: the length of the part's nodal arrays; node_reach: per part node, its reach
   /// (inflated_boxes; empty without shells), held by the caller.
   ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               std::span<const Index> surface_nodes, const Model& model, Index num_nodes,
+               const SurfaceVertices& vertices, const Model& model, Index num_nodes,
                std::span<const double> node_reach = {});
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
@@ -107,15 +116,16 @@ class ContactPatch {
   // every rank places), numbered in ascending whole id. Their states live in arrays of the
   // patch's own; the part's arrays are read and written for the kept nodes only.
   Index num_nodes() const { return static_cast<Index>(nodes_.size()); }
-  /// Patch node k's node in the part.
-  Index part_node(Index k) const { return surface_nodes_[nodes_[k]]; }
+  /// Patch node k's surface vertex, and its node in the part (-1 if not held there).
+  Index surface_vertex(Index k) const { return nodes_[k]; }
+  Index part_node(Index k) const { return vertices_.node[nodes_[k]]; }
   /// The patch node whose whole id is `whole` (it must be one), and patch node k's whole id.
   Index node(Index whole) const;
-  Index whole(Index k) const { return whole_[nodes_[k]]; }
+  Index whole(Index k) const { return vertices_.whole[nodes_[k]]; }
   /// The rank that owns patch node k (its volume owner).
-  int owner(Index k) const { return owner_[nodes_[k]]; }
+  int owner(Index k) const { return vertices_.owner[nodes_[k]]; }
   /// The volume owner of surface vertex v.
-  int vertex_owner(Index v) const { return owner_[v]; }
+  int vertex_owner(Index v) const { return vertices_.owner[v]; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
@@ -180,14 +190,12 @@ class ContactPatch {
   const Decomposition& dec_;
   const ContactSurface& surface_;
   const VertexTriangles& around_;
-  std::span<const Index> surface_nodes_;
+  const SurfaceVertices& vertices_;
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
   std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
-  std::vector<Index> whole_;  ///< per surface vertex: its whole id (ascending)
-  std::vector<int> owner_;    ///< per surface vertex: its volume owner
   std::vector<Index> kept_;   ///< the surface vertices whose part rows the time loop keeps (load())
   bool owned_once_ = false;
   std::vector<Index> owned_triangles_, owned_edges_;

@@ -38,7 +38,7 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
     shell_body_[shell.body] = 1;
     for (Index v = 0; v < shell.mesh.num_vertices(); ++v) reach_[shell.first_node + v] = 0.5 * shell.thickness;
   }
-  // A part of the model brings the whole model's surface.
+  // A part of the model brings the whole model's surface, in surface vertex ids.
   if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
   else rebuild(model.mesh);
 }
@@ -75,7 +75,7 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 bool ContactStage::excluded(const ContactPair& p) const {
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
   if (by_body()) {
-    const int a = node_body_[p.nodes[0]], b = node_body_[p.nodes[first]];
+    const int a = body_[p.nodes[0]], b = body_[p.nodes[first]];
     if ((!self_ || shell_body_[a]) && a == b) return true;
     // Free rigid bodies touch deformable ones only (DCR moves one rigid body per pair;
     // the scene refuses two that contact.pairs lets touch): their self-pairs drop.
@@ -93,35 +93,58 @@ bool ContactStage::excluded(const ContactPair& p) const {
 
 void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   surface_ = std::move(surface);
-  vertex_triangles_ = vertex_triangles(surface_);
-  std::vector<double> lengths;
-  lengths.reserve(surface_.edges.size());
-  for (const auto& [a, b] : surface_.edges) lengths.push_back((mesh.reference[a] - mesh.reference[b]).norm());
-  if (!lengths.empty()) {
-    std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-    margin_ = margin_fraction_ * lengths[lengths.size() / 2];
-  }
+  // A part has no rows of most surface nodes: its surface's median edge came with it.
+  margin_ = margin_fraction_ *
+            (model_.is_part() ? model_.part.surface_edge : median_edge_length(surface_, mesh.reference));
   have_candidates_ = false;
   pairs_.clear();
-  if (by_body()) node_body_ = mesh.node_body;
-  surface_nodes_.clear();
-  if (!dec_) return;
-  // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
-  // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
-  surface_nodes_ = surface_.vertices;
-  const std::vector<Index>& at = vertex_triangles_.position;
-  for (auto& t : surface_.triangles)
-    for (Index& n : t) n = at[n];
-  for (auto& e : surface_.edges)
-    for (Index& n : e) n = at[n];
-  std::iota(surface_.vertices.begin(), surface_.vertices.end(), 0);
+  body_.clear();
+  if (by_body()) body_ = mesh.node_body;
+  if (!dec_) {
+    vertex_triangles_ = vertex_triangles(surface_);
+    return;
+  }
+  set_vertices(mesh);
   vertex_triangles_ = vertex_triangles(surface_);
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, surface_nodes_, model_, mesh.num_nodes(),
+  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, vertices_, model_, mesh.num_nodes(),
                                           reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, *dec_);
   weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
+}
+
+void ContactStage::set_vertices(const Mesh& mesh) {
+  // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
+  // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
+  vertices_ = {};
+  if (model_.is_part()) {
+    const Model::Part& part = model_.part;
+    vertices_.whole = part.surface_node;
+    vertices_.owner = part.surface_owner;
+    vertices_.body = part.surface_body;
+    for (const Index whole : part.surface_node) vertices_.node.push_back(model_.local_node(whole));
+  } else {
+    vertices_.node = surface_.vertices;
+    const std::vector<Index> at = vertex_triangles(surface_).position;
+    for (auto& t : surface_.triangles)
+      for (Index& n : t) n = at[n];
+    for (auto& e : surface_.edges)
+      for (Index& n : e) n = at[n];
+    std::iota(surface_.vertices.begin(), surface_.vertices.end(), 0);
+    for (const Index n : vertices_.node) {
+      vertices_.whole.push_back(model_.whole_node(n));
+      vertices_.owner.push_back(dec_->node_owner(n));
+      vertices_.body.push_back(mesh.node_body[n]);
+    }
+  }
+  // excluded() reads the surface's ids: surface vertices here.
+  if (by_body()) body_ = vertices_.body;
+  if (!twin_of_.empty()) {
+    std::vector<Index> twin;
+    for (const Index n : vertices_.node) twin.push_back(twin_of_[n]);
+    twin_of_ = std::move(twin);
+  }
 }
 
 ContactStage::~ContactStage() = default;
@@ -205,7 +228,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
     for (size_t k = 0; k < found.pairs.size(); ++k) {
-      if (excluded(part_pair(found.pairs[k]))) continue;
+      if (excluded(surface_pair(found.pairs[k]))) continue;
       pairs_.push_back(found.pairs[k]);
       weight_[patch_->surface_primitive(found.primitive[k])] += 1.0f;
     }
@@ -241,10 +264,11 @@ std::vector<Index> ContactStage::partition() {
 }
 
 std::vector<std::int32_t> ContactStage::patch_rigid_bodies(const DcrRigidBodies& rigid) const {
-  // A rigid body's nodes are kept (ContactPatch): every part that holds one of them holds
-  // its row.
-  std::vector<std::int32_t> body(patch_->num_nodes());
-  for (Index k = 0; k < patch_->num_nodes(); ++k) body[k] = rigid.node_body[patch_->part_node(k)];
+  // A rigid body's surface nodes are kept (ContactPatch): every part holds their rows. A
+  // node the part does not hold is a deformable body's.
+  std::vector<std::int32_t> body(patch_->num_nodes(), -1);
+  for (Index k = 0; k < patch_->num_nodes(); ++k)
+    if (const Index n = patch_->part_node(k); n >= 0) body[k] = rigid.node_body[n];
   return body;
 }
 
@@ -265,8 +289,7 @@ ContactBalance ContactStage::balance() const {
   return b;
 }
 
-std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine,
-                                                          std::span<Vec3> x) const {
+std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine) {
   // Each rank's first pair (kind, whole ids of its nodes, their positions) to every rank.
   constexpr size_t kWords = 5 + 12;
   std::vector<double> out;
@@ -281,27 +304,42 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   size_t at_first = 0;
   for (size_t at = 0; at < all.size(); at += kWords) {
     ContactPair p{static_cast<ContactPair::Kind>(all[at]), {}};
-    for (int c = 0; c < 4; ++c) {
-      p.nodes[c] = model_.local_node(static_cast<Index>(all[at + 1 + c]));
-      SHATTER_ASSERT(p.nodes[c] >= 0);
-    }
+    for (int c = 0; c < 4; ++c) p.nodes[c] = static_cast<Index>(all[at + 1 + c]);
     if (!first || p < *first) first = p, at_first = at;
   }
-  // Its nodes' positions here too, for the diagnosis.
-  if (first)
-    for (int c = 0; c < 4; ++c) x[first->nodes[c]] = Vec3(all[at_first + 5 + 3 * c], all[at_first + 6 + 3 * c], all[at_first + 7 + 3 * c]);
+  if (!first) return first;
+  // Its name: the bodies are known here, each node's id (node_gid) to its owner.
+  UnresolvedPair& u = unresolved_.emplace();
+  u.kind = first->kind;
+  std::array<long, 4> gid{};
+  for (int c = 0; c < 4; ++c) {
+    const Index whole = first->nodes[c];
+    const auto v = std::lower_bound(vertices_.whole.begin(), vertices_.whole.end(), whole) - vertices_.whole.begin();
+    SHATTER_ASSERT(static_cast<size_t>(v) < vertices_.whole.size() && vertices_.whole[v] == whole);
+    u.body[c] = vertices_.body[v];
+    const Index n = vertices_.node[v];
+    gid[c] = n >= 0 && dec_->owns_node(n) ? model_.mesh.node_gid[n] : -1;
+    u.x[c] = Vec3(all[at_first + 5 + 3 * c], all[at_first + 6 + 3 * c], all[at_first + 7 + 3 * c]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, gid.data(), 4, MPI_LONG, MPI_MAX, dec_->comm());
+  for (int c = 0; c < 4; ++c) u.gid[c] = gid[c];
   return first;
 }
 
 ContactPairs ContactStage::active_pairs() const {
   const std::vector<Index>& kept = scratch_.overlapping;
   ContactPairs out(kept.size());
-  for (size_t k = 0; k < kept.size(); ++k) out[k] = dec_ ? part_pair(pairs_[kept[k]]) : pairs_[kept[k]];
+  for (size_t k = 0; k < kept.size(); ++k) out[k] = dec_ ? whole_pair(pairs_[kept[k]]) : pairs_[kept[k]];
   return out;
 }
 
-ContactPair ContactStage::part_pair(ContactPair p) const {
-  for (Index& n : p.nodes) n = patch_->part_node(n);
+ContactPair ContactStage::surface_pair(ContactPair p) const {
+  for (Index& n : p.nodes) n = patch_->surface_vertex(n);
+  return p;
+}
+
+ContactPair ContactStage::whole_pair(ContactPair p) const {
+  for (Index& n : p.nodes) n = patch_->whole(n);
   return p;
 }
 
@@ -329,6 +367,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   const double wait0 = dec_ ? ranks_->seconds() : 0, wait_cpu0 = dec_ ? ranks_->cpu_seconds() : 0;
   DcrResult r;
   double wait_cpu = 0;
+  unresolved_.reset();
   if (dec_) {
     // DCR on the patch's nodes.
     std::vector<std::int32_t> rigid_body;
@@ -344,10 +383,18 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     profile_.states_posted += ranks_->posted() - posted0;
     profile_.exchange_seconds += ranks_->seconds() - wait0;
     wait_cpu = ranks_->cpu_seconds() - wait_cpu0;
-    if (r.capped) r.unresolved = first_unresolved(r.unresolved, x_new);
+    if (r.capped) r.unresolved = first_unresolved(r.unresolved);
   } else {
     const DcrSurface surface{&surface_, &vertex_triangles_, {}, reach_};
     r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, nullptr, held, rigid);
+    if (r.unresolved) {
+      UnresolvedPair& u = unresolved_.emplace();
+      u.kind = r.unresolved->kind;
+      for (int c = 0; c < 4; ++c) {
+        const Index n = r.unresolved->nodes[c];
+        u.gid[c] = model_.mesh.node_gid[n], u.body[c] = model_.mesh.node_body[n], u.x[c] = x_new[n];
+      }
+    }
   }
   lap(profile_.sweep_seconds);
   profile_.sweep_cpu_seconds += thread_cpu_seconds() - cpu0 - wait_cpu;

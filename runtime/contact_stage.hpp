@@ -34,6 +34,7 @@
 #include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
 #include "contact/surface.hpp"
+#include "runtime/contact_patch.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {
@@ -61,6 +62,15 @@ struct ContactProfile {
   double sweep_cpu_seconds = 0;   ///< DCR, less the gathers
 };
 
+/// A pair DCR left penetrating at the sweep cap, named for the diagnosis: its kind, its
+/// nodes' ids (node_gid), bodies and positions x(n+1).
+struct UnresolvedPair {
+  ContactPair::Kind kind = ContactPair::VertexFace;
+  std::array<GlobalId, 4> gid{};
+  std::array<int, 4> body{};
+  std::array<Vec3, 4> x{};
+};
+
 /// ContactProfile over the ranks (ContactStage::balance, summary.json).
 struct ContactBalance {
   long pairs_min = 0, pairs_max = 0, pairs_sum = 0;  ///< ContactProfile::owned_pairs
@@ -72,8 +82,6 @@ struct ContactBalance {
 
 class Decomposition;
 class ContactPartition;
-class ContactPatch;
-enum class PatchPlan;
 class PatchRanks;
 
 class ContactStage {
@@ -92,9 +100,9 @@ class ContactStage {
   /// of the last step, as the time loop's x(n) is), and every node a pair moved
   /// gets its final state on every rank that touches it or holds it in its patch.
   /// The result's contacts, dissipated, support_work and work are then this rank's part;
-  /// when capped, unresolved is the first pair over all ranks (and its nodes' x_new
-  /// are written here). rigid (null: none): the free rigid bodies (resolve_contacts); the
-  /// result's rigid sums are this rank's part.
+  /// when capped, unresolved is the first pair over all ranks, in whole-model node ids.
+  /// rigid (null: none): the free rigid bodies (resolve_contacts); the result's rigid sums
+  /// are this rank's part. When capped, unresolved() names the pair on every rank.
   DcrResult apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v,
                   std::span<const double> inv_mass, double dt, std::span<const std::uint8_t> held = {},
                   const DcrRigidBodies* rigid = nullptr);
@@ -111,13 +119,17 @@ class ContactStage {
   /// The contact surface: in the mesh's node ids on one rank; on several, in surface vertex
   /// ids (vertex k is the surface's k-th node, surface_nodes()[k] here).
   const ContactSurface& surface() const { return surface_; }
-  /// The surface's nodes, ascending (mesh node ids).
-  std::span<const Index> surface_nodes() const { return dec_ ? surface_nodes_ : surface_.vertices; }
+  /// The surface's nodes, ascending (mesh node ids; on several ranks, -1 for a node the
+  /// part does not hold).
+  std::span<const Index> surface_nodes() const { return dec_ ? vertices_.node : surface_.vertices; }
   /// The candidates of the search in force (on several ranks, this rank's).
   const ContactPairs& candidates() const { return pairs_; }
-  /// This rank's pairs that DCR checked in the last apply(): on one rank, equal to the
-  /// pairs of a fresh search whose swept boxes overlap.
+  /// This rank's pairs that DCR checked in the last apply(), in whole-model node ids: on one
+  /// rank, equal to the pairs of a fresh search whose swept boxes overlap.
   ContactPairs active_pairs() const;
+  /// The first pair left penetrating by the last apply() that reached the sweep cap (the
+  /// same on every rank), else none.
+  const std::optional<UnresolvedPair>& unresolved() const { return unresolved_; }
   /// Seconds spent in the search (the reuse check included) and in DCR (the step's box test,
   /// detection, coloring, resolution) so far; number of searches run.
   double search_seconds() const { return profile_.verlet_seconds + profile_.search_seconds; }
@@ -131,54 +143,60 @@ class ContactStage {
   double margin() const { return margin_; }
 
  private:
-  /// The surface (of `mesh`'s nodes) and what depends on it: the search
-  /// margin, the candidates, the RCB order.
+  /// The surface (of `mesh`'s nodes; on a part, of surface vertex ids) and what depends on
+  /// it: the search margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
+  /// On several ranks: vertices_, with the surface (of mesh node ids on a whole model)
+  /// turned to surface vertex ids.
+  void set_vertices(const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
-  /// Whether the pair is left out: its primitives share a node, twins counted as one
-  /// (rebuild), its bodies are not a pair of contact.pairs, they are one body and
-  /// contact.self is false, or both are free rigid bodies.
+  /// Whether the pair (of the surface's ids: mesh nodes on one rank, surface vertices on
+  /// several) is left out: its primitives share a node, twins counted as one (rebuild), its
+  /// bodies are not a pair of contact.pairs, they are one body and contact.self is false, or
+  /// both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
-  /// Whether excluded() reads the pairs' bodies (node_body_).
+  /// Whether excluded() reads the pairs' bodies (body_).
   bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
   void search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
-  /// On several ranks: the first (canonical order) of every rank's `mine`; its nodes' x
-  /// from the rank that found it are written into x (collective).
-  std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine, std::span<Vec3> x) const;
+  /// On several ranks: the first (canonical order) of every rank's `mine` (patch ids), in
+  /// whole ids, named in unresolved_ (collective).
+  std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine);
   /// The primitives owned here after an RCB partition of the owned ones at the patch's
   /// x(n+1), weighted by their candidates.
   std::vector<Index> partition();
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
-  /// A pair of patch nodes as the part's nodes.
-  ContactPair part_pair(ContactPair p) const;
+  /// A pair of patch nodes as surface vertices, or as whole-model nodes.
+  ContactPair surface_pair(ContactPair p) const;
+  ContactPair whole_pair(ContactPair p) const;
   /// Per patch node, its free rigid body (rigid.node_body's), from the part's rows.
   std::vector<std::int32_t> patch_rigid_bodies(const DcrRigidBodies& rigid) const;
 
   const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
-  std::vector<Index> surface_nodes_;  ///< several ranks: per surface vertex, its node here
+  SurfaceVertices vertices_;          ///< several ranks: what is known of each surface vertex
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
   bool have_candidates_ = false;
   ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
-  std::vector<Index> twin_of_;  ///< per node, its twins' representative (the smallest id); empty: no twins
+  std::vector<Index> twin_of_;  ///< per surface id, its twins' representative (the smallest node); empty: no twins
   std::vector<std::array<int, 2>> body_pairs_;  ///< contact.pairs (empty: all)
   bool self_ = true;                            ///< contact.self
   std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free
   bool any_free_rigid_ = false;
-  std::vector<int> node_body_;                  ///< per node, its body (with contact.pairs or contact.self: false, or shells)
+  std::vector<int> body_;  ///< per surface id, its body (with contact.pairs or contact.self: false, or shells)
   std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
   std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells (grows the search boxes: inflated_boxes)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
   DcrScratch scratch_;
   ContactProfile profile_;
+  std::optional<UnresolvedPair> unresolved_;
   // Several ranks:
   const Decomposition* dec_ = nullptr;  ///< null on one rank
   std::unique_ptr<ContactPartition> partition_;

@@ -7,19 +7,18 @@
 
 namespace shatter {
 
-std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const DcrResult& r, long step,
+std::string sweep_cap_diagnosis(const Model& model, const std::optional<UnresolvedPair>& pair, long step,
                                 double time) {
   std::ostringstream os;
   os << "step " << step << ", t = " << time << " s: DCR sweeps reached the cap (contact.max_sweeps = "
      << model.scene.contact->max_sweeps << ") with penetrations left (contact.on_sweep_cap: fail)";
-  if (r.unresolved) {
-    const ContactPair& p = *r.unresolved;
+  if (pair) {
     Vec3 centre = Vec3::Zero();
-    os << "; still penetrating: " << (p.kind == ContactPair::VertexFace ? "vertex-face" : "edge-edge")
+    os << "; still penetrating: " << (pair->kind == ContactPair::VertexFace ? "vertex-face" : "edge-edge")
        << " pair of nodes";
-    for (const Index n : p.nodes) {
-      os << " " << model.mesh.node_gid[n] << " ('" << model.scene.bodies[model.mesh.node_body[n]].name << "')";
-      centre += 0.25 * x[n];
+    for (int c = 0; c < 4; ++c) {
+      os << " " << pair->gid[c] << " ('" << model.scene.bodies[pair->body[c]].name << "')";
+      centre += 0.25 * pair->x[c];
     }
     os << " near (" << centre.x() << ", " << centre.y() << ", " << centre.z() << ")";
   }

@@ -1,19 +1,22 @@
 #pragma once
 // What, where and when of the failures a step detects (docs/errors.md "During
 // a run"): the messages name the nodes, bodies, positions and remedies.
+#include <optional>
 #include <span>
 #include <string>
 
 #include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
+#include "runtime/contact_stage.hpp"
 #include "runtime/ledger.hpp"
 #include "runtime/model.hpp"
 
 namespace shatter {
 
 /// A step whose DCR sweeps reached the cap, when the scene says
-/// contact.on_sweep_cap: fail. `step` is the step under way.
-std::string sweep_cap_diagnosis(const Model& model, std::span<const Vec3> x, const DcrResult& r, long step,
+/// contact.on_sweep_cap: fail; `pair`: the first pair left penetrating
+/// (ContactStage::unresolved). `step` is the step under way.
+std::string sweep_cap_diagnosis(const Model& model, const std::optional<UnresolvedPair>& pair, long step,
                                 double time);
 
 /// The stable step of a step's configuration and the element that sets it

@@ -66,8 +66,8 @@ struct Model {
 
   /// A rank's part of the whole model (docs/parallel.md "Owned subdomains"):
   /// its owned elements and their ghost layer, ascending in the whole
-  /// model's order, and the nodes they use (with contact, and the contact
-  /// surface's nodes). With fracture, two ghost layers (holds_two_layers()).
+  /// model's order, and the nodes they use (with contact, and the rigid
+  /// bodies' surface nodes). With fracture, two ghost layers (holds_two_layers()).
   /// Empty `element_index`: this model is the whole one (one rank, or a
   /// scene every rank holds whole).
   struct Part {
@@ -80,9 +80,15 @@ struct Model {
     std::vector<Index> node_rank_offsets;
     std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
-    /// Contact scenes: the whole model's contact surface (build_contact_surface),
-    /// in local node ids; its nodes are held here, in elements or not.
+    /// Contact scenes: the whole model's contact surface (build_contact_surface) in
+    /// surface vertex ids (vertex k: the surface's k-th node, ascending in whole id), and
+    /// per surface vertex its whole id, its volume owner and its body. The part holds the
+    /// rows of its elements' nodes and of the rigid bodies' surface nodes only
+    /// (docs/parallel.md "Patches with their own topology", step 4).
     std::vector<SurfaceTriangle> surface;
+    std::vector<Index> surface_node;
+    std::vector<int> surface_owner, surface_body;
+    double surface_edge = 0;  ///< the surface's median edge length (median_edge_length)
     Index whole_elements = 0, whole_nodes = 0, whole_bc_nodes = 0;
     std::uint64_t fingerprint = 0;     ///< model_fingerprint() of the whole model
   } part;
@@ -112,6 +118,7 @@ void for_each_array(M& m, F f) {
   f(m.bc_velocity), f(m.bc_condition), f(m.load_faces), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
   f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index), f(m.part.surface);
+  f(m.part.surface_node), f(m.part.surface_owner), f(m.part.surface_body);
 }
 
 /// The model's per-node arrays that node splitting grows, in one order

@@ -1,6 +1,7 @@
 #include "runtime/model_part.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -27,7 +28,12 @@ struct Partition {
   NodeRanks touch;
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
-  ContactSurface surface;       ///< contact scenes: of the whole model
+  // Contact scenes: the whole model's surface as the parts hold it (Model::Part).
+  std::vector<SurfaceTriangle> surface;
+  std::vector<Index> surface_node;
+  std::vector<int> surface_owner, surface_body;
+  double surface_edge = 0;
+  std::vector<Index> rigid_surface_nodes;  ///< the rigid bodies' surface nodes, which every part holds
 };
 
 Partition partition(const Model& whole, int ranks) {
@@ -39,7 +45,21 @@ Partition partition(const Model& whole, int ranks) {
   p.bc_index.assign(mesh.num_nodes(), -1);
   for (Index n = 0; n < mesh.num_nodes(); ++n)
     if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;
-  if (whole.scene.contact) p.surface = build_contact_surface(mesh);
+  if (!whole.scene.contact) return p;
+  // The surface in surface vertex ids, and what every part knows of each vertex.
+  const ContactSurface surface = build_contact_surface(mesh);
+  const VertexTriangles around = vertex_triangles(surface);
+  p.surface_edge = median_edge_length(surface, mesh.reference);
+  p.surface_node = surface.vertices;
+  for (size_t t = 0; t < surface.triangles.size(); ++t) {
+    const auto& [a, b, c] = surface.triangles[t];
+    p.surface.push_back({{around.position[a], around.position[b], around.position[c]}, surface.body[t]});
+  }
+  for (const Index n : surface.vertices) {
+    p.surface_owner.push_back(p.touch.of(n)[0]);
+    p.surface_body.push_back(mesh.node_body[n]);
+    if (whole.scene.bodies[mesh.node_body[n]].has_rigid_state()) p.rigid_surface_nodes.push_back(n);
+  }
   return p;
 }
 
@@ -98,7 +118,7 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   part.element_index = std::move(elements);
   for (Index e : part.element_index)
     for (int a = 0; a < k; ++a) part.node_index.push_back(wm.element(e)[a]);
-  part.node_index.insert(part.node_index.end(), p.surface.vertices.begin(), p.surface.vertices.end());
+  part.node_index.insert(part.node_index.end(), p.rigid_surface_nodes.begin(), p.rigid_surface_nodes.end());
   std::sort(part.node_index.begin(), part.node_index.end());
   part.node_index.erase(std::unique(part.node_index.begin(), part.node_index.end()), part.node_index.end());
   for (size_t i = 0; i < part.node_index.size(); ++i) local[part.node_index[i]] = static_cast<Index>(i);
@@ -133,10 +153,11 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   }
   mesh.build_node_elements();
   m.load_faces = held_load_faces(whole.load_faces, part.element_index);
-  for (size_t t = 0; t < p.surface.triangles.size(); ++t) {
-    const auto& [a, b, c] = p.surface.triangles[t];
-    part.surface.push_back({{local[a], local[b], local[c]}, p.surface.body[t]});
-  }
+  part.surface = p.surface;
+  part.surface_node = p.surface_node;
+  part.surface_owner = p.surface_owner;
+  part.surface_body = p.surface_body;
+  part.surface_edge = p.surface_edge;
   m.body_mass = whole.body_mass;
   m.body_volume = whole.body_volume;
   for (Index n : part.node_index) local[n] = -1;
@@ -171,10 +192,11 @@ void cut_parts(const Model& whole, int ranks, const std::function<void(int, Mode
 }
 
 void put_part(const Model& m, const std::function<void(const void*, std::uint64_t)>& put) {
-  const std::uint64_t head[6] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
+  const std::uint64_t head[7] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
                                  static_cast<std::uint64_t>(m.part.whole_elements),
                                  static_cast<std::uint64_t>(m.part.whole_nodes),
-                                 static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint};
+                                 static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint,
+                                 std::bit_cast<std::uint64_t>(m.part.surface_edge)};
   put(head, sizeof head);
   for_each_array(m, [&](const auto& v) {
     const std::uint64_t n = v.size();
@@ -184,7 +206,7 @@ void put_part(const Model& m, const std::function<void(const void*, std::uint64_
 }
 
 bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std::uint64_t)>& get) {
-  std::uint64_t head[6];
+  std::uint64_t head[7];
   if (limit < sizeof head) return false;
   get(head, sizeof head);
   limit -= sizeof head;
@@ -194,6 +216,7 @@ bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std
   m.part.whole_nodes = static_cast<Index>(head[3]);
   m.part.whole_bc_nodes = static_cast<Index>(head[4]);
   m.part.fingerprint = head[5];
+  m.part.surface_edge = std::bit_cast<double>(head[6]);
   bool fits = true;
   for_each_array(m, [&](auto& v) {
     std::uint64_t n = 0;

@@ -272,7 +272,7 @@ void Simulation::resolve_contact() {
   step_work_[kContactsResolved] += static_cast<double>(r.contacts);
   if (r.capped) {
     if (model_.scene.contact->sweep_cap_fatal)
-      throw Error(sweep_cap_diagnosis(model_, x_, r, step_ + 1, time_ + dt_));
+      throw Error(sweep_cap_diagnosis(model_, contact_->unresolved(), step_ + 1, time_ + dt_));
     if (ledger_.contact_capped_steps == 0 && dec_->rank() == 0)
       std::fprintf(stderr,
                    "\nwarning: step %ld: DCR sweeps reached the cap (%d) with penetrations left; "
@@ -391,7 +391,7 @@ void Simulation::rebuild_contact_surface() {
 void Simulation::count_contact_vertices() {
   contact_vertices_.clear();
   for (const Index i : contact_->surface_nodes())
-    if (dec_->owns_node(i)) contact_vertices_.push_back(i);
+    if (i >= 0 && dec_->owns_node(i)) contact_vertices_.push_back(i);
 }
 
 void Simulation::share_plans(const Insertion* after) {

@@ -11,6 +11,10 @@
 #   - every rank finds the stable step collapsed (a face driven at 300 m/s
 #     crushes the box): exit 1, one error line, the same as on one rank (the
 #     element with the smallest step over all ranks), a checkpoint;
+#   - DCR reaches its sweep cap with contact.on_sweep_cap: fail (a block
+#     dropped on a plate, one sweep a step): exit 1, one error line, the same
+#     as on one rank (the first pair left over all ranks, named by its nodes'
+#     ids and bodies though the part holds no row of some of them);
 #   - bad input on every rank: exit 2, one error line;
 #   - a mesh too small for the ranks (fewer granules of 256 elements than
 #     ranks): exit 2, one error line that says how many ranks it can take;
@@ -77,6 +81,27 @@ run collapse 1 "the stable step collapsed" "${mpi[@]}" --out "$work/collapse" "$
 timeout -k 10 "$limit" "$shatter" run "$work/box.yaml" --threads 1 --quiet --out "$work/collapse1" "${crush[@]}" > "$work/collapse1.log" 2>&1
 [ "$(grep '^error: ' "$work/collapse.log")" = "$(grep '^error: ' "$work/collapse1.log")" ] && [ -f "$work/collapse/checkpoint.h5" ] ||
   { echo "FAIL collapse: not the message of one rank, or no checkpoint:"; cat "$work/collapse1.log"; fail=1; }
+
+cat > "$work/drop.yaml" <<'YAML'
+name: drop
+time: {end: 2.0e-5}
+output: {every: 0}
+materials:
+  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}
+bodies:
+  - {name: plate, material: steel, mesh: {shape: box, size: [0.06, 0.03, 0.01], center: [0, 0, -0.005], element_size: 0.003}}
+  - {name: block, material: steel, mesh: {shape: box, size: [0.01, 0.01, 0.01], center: [0, 0, 0.005001], element_size: 0.003},
+     initial_velocity: [5, 0, -5]}
+boundary_conditions:
+  - {body: plate, region: {box: [[-1, -1, -1], [1, 1, -0.00999]]}, velocity: [0, 0, 0]}
+contact: {restitution: 0.5, max_sweeps: 1, on_sweep_cap: fail}
+YAML
+run sweep_cap 1 "DCR sweeps reached the cap" "$mpiexec" --allow-run-as-root --oversubscribe -n 2 "$shatter" run \
+  "$work/drop.yaml" --threads 1 --quiet --out "$work/sweep_cap"
+timeout -k 10 "$limit" "$shatter" run "$work/drop.yaml" --threads 1 --quiet --out "$work/sweep_cap1" > "$work/sweep_cap1.log" 2>&1
+[ "$(grep '^error: ' "$work/sweep_cap.log")" = "$(grep '^error: ' "$work/sweep_cap1.log")" ] &&
+  grep -q "still penetrating: [a-z-]* pair of nodes [0-9]* (.[a-z]*.) [0-9]* (.[a-z]*.) [0-9]* (.[a-z]*.) [0-9]* (.[a-z]*.) near" "$work/sweep_cap.log" ||
+  { echo "FAIL sweep_cap: not the message of one rank, or no pair named:"; cat "$work/sweep_cap1.log"; fail=1; }
 
 run bad_input 2 "time.end: expected a positive number, got 'soon'" "${mpi[@]}" --out "$work/bad" --set time.end=soon
 run too_many_ranks 2 "cannot be shared by 2 MPI ranks (use at most 1)" "${mpi[@]}" --out "$work/small" \
