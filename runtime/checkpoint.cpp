@@ -23,6 +23,7 @@
 #include "runtime/first_failure.hpp"
 #include "runtime/hdf5_failure.hpp"
 #include "runtime/hdf5_rows.hpp"
+#include "runtime/restart_rows.hpp"
 #include "runtime/row_blocks.hpp"
 #include "runtime/scene_keys.hpp"
 
@@ -450,6 +451,18 @@ struct Reader {
                          std::span<const char> counted) const {
     return array<Vec3>(group, name, expected, 3, keep, counted);
   }
+  /// Rank `rank`'s block of such a dataset, of `ranks` blocks: its rows [N rank / ranks,
+  /// N (rank + 1) / ranks), into `out`; returns the first. The block's rows are hashed here
+  /// (over the ranks, every row once).
+  template <class T>
+  std::size_t block(hid_t group, const char* name, std::size_t expected, hsize_t cols, int rank, int ranks,
+                    std::vector<T>& out) const {
+    const std::size_t first = expected * rank / ranks, last = expected * (rank + 1) / ranks;
+    std::vector<Index> keep(last - first);
+    std::iota(keep.begin(), keep.end(), static_cast<Index>(first));
+    out = array<T>(group, name, expected, cols, keep, std::vector<char>(keep.size(), 1));
+    return first;
+  }
   /// The datasets read in part: each rank's sums of its counted rows, added
   /// over the ranks of `comm` (one reduction) and checked against the stored hashes.
   void check_parts(MPI_Comm comm) const {
@@ -824,77 +837,84 @@ std::vector<int> fracture_node_owners(const Model& model, const FractureState& f
 /// A part's share of a checkpoint's fracture state (docs/parallel.md "Fracture
 /// on parts"): the conn rows of its elements, the rows of their nodes, and
 /// the facets and cohesive elements of facets one of whose elements it holds
-/// (FractureStage::restore keeps those it holds both of). Its rows are
+/// (FractureState::restore keeps those it holds both of). Its rows are
 /// hashed by their owners (Reader::array): an element's by its rank, a
 /// node's by the smallest rank owning an element that uses it (every node of
 /// an owned element has its whole star here), a facet's and its cohesive
-/// element's by the owner of its element g.
+/// element's by the owner of its element g. The rows of bc_mask, facet_gid
+/// and cohesive_facet are found by the ranks together (restart_rows.hpp);
+/// a refusal on any rank is every rank's before and after those collectives.
 void read_fracture_part(const Reader& r, hid_t fr, const Model& model, std::size_t elements, std::size_t facets,
-                        int rank, FractureState& f) {
+                        MPI_Comm comm, FractureState& f) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
   const auto n = static_cast<std::size_t>(f.whole_nodes), nc = static_cast<std::size_t>(f.whole_cohesive);
   const int k = model.mesh.nodes_per_element();
   const std::vector<Index>& held_elements = model.part.element_index;
-  std::vector<char> owned_elements;
-  for (Index e : held_elements) owned_elements.push_back(model.part.granule_rank[e / ElementForces::kGranule] == rank);
-  f.conn = r.array<Index>(fr, "conn", elements, k, held_elements, owned_elements);
-  f.node_rows = f.conn;
-  std::sort(f.node_rows.begin(), f.node_rows.end());
-  f.node_rows.erase(std::unique(f.node_rows.begin(), f.node_rows.end()), f.node_rows.end());
-  r.require(f.node_rows.empty() || (f.node_rows.front() >= 0 && static_cast<std::size_t>(f.node_rows.back()) < n),
-            "/fracture/conn names a node out of range (corrupted checkpoint?)");
-  const std::span<const Index> rows = f.node_rows;
-  std::vector<char> counted;
-  for (int o : fracture_node_owners(model, f)) counted.push_back(o == rank);
-  f.reference = r.rows(fr, "reference", n, rows, counted);
-  f.node_gid = r.array<GlobalId>(fr, "node_gid", n, 1, rows, counted);
-  f.node_body = r.array<int>(fr, "node_body", n, 1, rows, counted);
-  f.mass = r.array<double>(fr, "mass", n, 1, rows, counted);
-  // The bc mask of the rows, and each prescribed row's rank among the whole
-  // model's (1 byte a node, read whole).
-  std::size_t next = 0;
-  r.blocks<std::uint8_t>(fr, "bc_mask", n, 1, [&](std::size_t first, std::span<const std::uint8_t> block) {
-    for (std::size_t i = 0; i < block.size(); ++i) {
-      const bool kept = next < rows.size() && static_cast<std::size_t>(rows[next]) == first + i;
-      if (kept) {
-        f.bc_mask.push_back(block[i]);
-        if (block[i]) f.bc_rows.push_back(f.whole_bc_nodes);
-        ++next;
-      }
-      f.whole_bc_nodes += block[i] != 0;
-    }
-  });
-  f.bc_velocity = r.rows(fr, "bc_velocity", n, rows, counted);
-  f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3, rows, counted);
-  f.initial_velocity = r.rows(fr, "initial_velocity", n, rows, counted);
+  std::vector<std::uint8_t> bc_block;
+  std::vector<GlobalId> facet_block, cohesive_block;
+  std::string error;
+  try {
+    std::vector<char> owned_elements;
+    for (Index e : held_elements) owned_elements.push_back(model.part.granule_rank[e / ElementForces::kGranule] == rank);
+    f.conn = r.array<Index>(fr, "conn", elements, k, held_elements, owned_elements);
+    f.node_rows = f.conn;
+    std::sort(f.node_rows.begin(), f.node_rows.end());
+    f.node_rows.erase(std::unique(f.node_rows.begin(), f.node_rows.end()), f.node_rows.end());
+    r.require(f.node_rows.empty() || (f.node_rows.front() >= 0 && static_cast<std::size_t>(f.node_rows.back()) < n),
+              "/fracture/conn names a node out of range (corrupted checkpoint?)");
+    const std::span<const Index> rows = f.node_rows;
+    std::vector<char> counted;
+    for (int o : fracture_node_owners(model, f)) counted.push_back(o == rank);
+    f.reference = r.rows(fr, "reference", n, rows, counted);
+    f.node_gid = r.array<GlobalId>(fr, "node_gid", n, 1, rows, counted);
+    f.node_body = r.array<int>(fr, "node_body", n, 1, rows, counted);
+    f.mass = r.array<double>(fr, "mass", n, 1, rows, counted);
+    f.bc_velocity = r.rows(fr, "bc_velocity", n, rows, counted);
+    f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3, rows, counted);
+    f.initial_velocity = r.rows(fr, "initial_velocity", n, rows, counted);
+    r.block(fr, "bc_mask", n, 1, rank, ranks, bc_block);
+    r.block(fr, "facet_gid", facets, 1, rank, ranks, facet_block);
+    r.block(fr, "cohesive_facet", nc, 1, rank, ranks, cohesive_block);
+    r.require(std::is_sorted(facet_block.begin(), facet_block.end()),
+              "/fracture/facet_gid is not ascending (corrupted checkpoint?)");
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  if (error = first_failure(error, comm); !error.empty()) throw InputError(error);
+  // The bc mask of the rows, and each prescribed row's rank among the whole model's.
+  PartBcRows bc = part_bc_rows(bc_block, n, f.node_rows, comm);
+  f.bc_mask = std::move(bc.mask);
+  f.bc_rows = std::move(bc.bc_rows);
+  f.whole_bc_nodes = bc.whole_bc_nodes;
   // Facets by global id, 4 g + face with g the smaller element's: those of the part's elements.
   std::vector<GlobalId> held(model.mesh.elem_gid.begin(), model.mesh.elem_gid.end());
   std::sort(held.begin(), held.end());
-  auto of_part = [&](GlobalId facet) { return std::binary_search(held.begin(), held.end(), facet / 4); };
-  // The facet ids of the cracked facets are read whole (8 bytes per cracked
-  // facet) to find the part's; each dataset is read once: the whole file's
-  // digest counts every hash read.
-  auto part_rows = [&](const char* name, std::size_t count, std::vector<GlobalId>& gids) {
-    std::vector<Index> keep;
-    r.blocks<GlobalId>(fr, name, count, 1, [&](std::size_t first, std::span<const GlobalId> block) {
-      for (std::size_t i = 0; i < block.size(); ++i)
-        if (of_part(block[i])) {
-          keep.push_back(static_cast<Index>(first + i));
-          gids.push_back(block[i]);
-        }
-    });
-    return keep;
-  };
-  const std::vector<Index> open = part_rows("facet_gid", facets, f.facet_gid);
-  f.facet_state = r.array<FacetState>(fr, "facet_state", facets, 1, open, facet_owned(model, f.facet_gid, rank));
-  f.cohesive_whole = part_rows("cohesive_facet", nc, f.cohesive_facet_gid);
-  const std::span<const Index> mine = f.cohesive_whole;
-  const std::vector<char> owned = facet_owned(model, f.cohesive_facet_gid, rank);
-  CohesiveElements& c = f.cohesive;
-  c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots, mine, owned);
-  c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots, mine, owned);
-  c.area = r.array<double>(fr, "cohesive_area", nc, 1, mine, owned);
-  c.normal = r.rows(fr, "cohesive_normal", nc, mine, owned);
-  c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints, mine, owned);
+  PartFacets found = part_facets(facet_block, facets, cohesive_block, nc, held, comm);
+  error = found.error;
+  try {
+    if (error.empty()) {
+      f.facet_gid = std::move(found.facet_gid);
+      f.facet_state = r.array<FacetState>(fr, "facet_state", facets, 1, found.facet_rows,
+                                          facet_owned(model, f.facet_gid, rank));
+      f.cohesive_whole = std::move(found.cohesive_rows);
+      f.cohesive_facet_gid = std::move(found.cohesive_gid);
+      const std::span<const Index> mine = f.cohesive_whole;
+      const std::vector<char> owned = facet_owned(model, f.cohesive_facet_gid, rank);
+      CohesiveElements& c = f.cohesive;
+      c.side_local = r.array<std::int8_t>(fr, "cohesive_side_local", nc, kCohesiveSlots, mine, owned);
+      c.side_nodes = r.array<Index>(fr, "cohesive_side_nodes", nc, kCohesiveSlots, mine, owned);
+      c.area = r.array<double>(fr, "cohesive_area", nc, 1, mine, owned);
+      c.normal = r.rows(fr, "cohesive_normal", nc, mine, owned);
+      c.delta_max = r.array<double>(fr, "cohesive_delta_max", nc, kCohesivePoints, mine, owned);
+    } else {
+      r.fail(error);
+    }
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  if (error = first_failure(error, comm); !error.empty()) throw InputError(error);
 }
 
 /// Whether this part (rank `rank`) is the owner of each of its nodes, as
@@ -908,9 +928,9 @@ std::vector<char> nodes_owned(const Model& model, int rank) {
   return owned;
 }
 
-/// read_checkpoint's reading on one rank (`rank` of the parts' ranks).
+/// read_checkpoint's reading on one rank (`rank` of the parts' ranks, `comm`).
 SimulationState read_state(Reader& r, const std::filesystem::path& path, const Model& model, CheckpointRun* run,
-                           int rank) {
+                           int rank, MPI_Comm comm) {
   r.require(std::filesystem::is_regular_file(path), "no such file");
   const QuietHdf5 quiet;
   r.require(H5Fis_hdf5(path.c_str()) > 0,
@@ -992,7 +1012,7 @@ SimulationState read_state(Reader& r, const std::filesystem::path& path, const M
     f.whole_nodes = static_cast<Index>(fn);
     f.whole_cohesive = static_cast<Index>(cohesive);
     if (model.is_part()) {
-      read_fracture_part(r, fr, model, static_cast<std::size_t>(elements), static_cast<std::size_t>(facets), rank, f);
+      read_fracture_part(r, fr, model, static_cast<std::size_t>(elements), static_cast<std::size_t>(facets), comm, f);
     } else {
       read_fracture_whole(r, fr, model, static_cast<std::size_t>(elements), static_cast<std::size_t>(facets), f);
     }
@@ -1091,7 +1111,7 @@ SimulationState read_state(Reader& r, const std::filesystem::path& path, const M
 SimulationState read_checkpoint(const std::filesystem::path& path, const Model& model, CheckpointRun* run,
                                 MPI_Comm comm) {
   Reader r{path.string(), kVersion, {}, {}};
-  if (!model.is_part()) return read_state(r, path, model, run, 0);
+  if (!model.is_part()) return read_state(r, path, model, run, 0, comm);
   // The parts read together: one rank's refusal is every rank's, then the
   // datasets' hashes are the sums of their owners' rows.
   int rank = 0;
@@ -1099,7 +1119,7 @@ SimulationState read_checkpoint(const std::filesystem::path& path, const Model& 
   SimulationState s;
   std::string error;
   try {
-    s = read_state(r, path, model, run, rank);
+    s = read_state(r, path, model, run, rank, comm);
   } catch (const InputError& e) {
     error = e.what();
   }
