@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "mpi_environment.hpp"
+#include "contact/surface.hpp"
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
@@ -311,6 +312,50 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   Scene bad = scene;
   bad.bodies[0].mesh_file = "/nonexistent/body.msh";
   EXPECT_THROW(build_model(bad, MPI_COMM_WORLD), InputError);
+}
+
+TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
+  // A contact scene's part holds the rows of its elements' nodes and of the rigid
+  // bodies' surface nodes only; the whole surface comes with it in surface vertex ids,
+  // with each vertex's whole id, volume owner and body, and the median edge.
+  const Scene scene = rank_scene(
+      "contact_parts",
+      "name: contact_parts\ntime: {end: 1.0e-5}\n"
+      "materials:\n  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
+      "bodies:\n"
+      "  - {name: plate, material: steel, mesh: {shape: box, size: [0.06, 0.03, 0.01], center: [0, 0, -0.005], "
+      "element_size: 0.003}}\n"
+      "  - {name: block, material: steel, rigid: free, mesh: {shape: box, size: [0.01, 0.01, 0.01], "
+      "center: [0, 0, 0.006], element_size: 0.003}, initial_velocity: [0, 0, -5]}\n"
+      "contact: {}\n");
+  const Model part = build_model(scene, MPI_COMM_WORLD);
+  const Model whole = build_model(scene);
+  if (!part.is_part()) return;
+  const ContactSurface surface = build_contact_surface(whole.mesh);
+  const Model::Part& p = part.part;
+  EXPECT_EQ(p.surface_node, surface.vertices);
+  EXPECT_EQ(p.surface_edge, median_edge_length(surface, whole.mesh.reference));
+  ASSERT_EQ(p.surface.size(), surface.triangles.size());
+  for (size_t t = 0; t < surface.triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(p.surface_node[p.surface[t].nodes[c]], surface.triangles[t][c]);
+  const Decomposition d(part, MPI_COMM_WORLD);
+  std::vector<char> in_element(part.mesh.num_nodes(), 0);
+  for (Index e = 0; e < part.mesh.num_elements(); ++e)
+    for (int a = 0; a < part.mesh.nodes_per_element(); ++a) in_element[part.mesh.element(e)[a]] = 1;
+  long surface_only_elsewhere = 0;
+  for (size_t k = 0; k < surface.vertices.size(); ++k) {
+    const Index n = part.local_node(surface.vertices[k]);
+    EXPECT_EQ(p.surface_body[k], whole.mesh.node_body[surface.vertices[k]]);
+    const bool rigid = scene.bodies[p.surface_body[k]].has_rigid_state();
+    if (n < 0) {
+      EXPECT_FALSE(rigid) << "a rigid body's surface node " << surface.vertices[k] << " is not held";
+      ++surface_only_elsewhere;
+      continue;
+    }
+    EXPECT_TRUE(in_element[n] || rigid) << "surface node " << surface.vertices[k] << " held outside the elements";
+    if (in_element[n]) EXPECT_EQ(p.surface_owner[k], d.node_owner(n));
+  }
+  EXPECT_GT(surface_only_elsewhere, 0) << "every part held every surface node";
 }
 
 TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
