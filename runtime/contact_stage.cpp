@@ -99,8 +99,8 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   have_candidates_ = false;
   pairs_.clear();
   body_.clear();
-  if (by_body()) body_ = mesh.node_body;
   if (!dec_) {
+    if (by_body()) body_ = mesh.node_body;
     vertex_triangles_ = vertex_triangles(surface_);
     return;
   }
