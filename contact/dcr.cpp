@@ -170,7 +170,10 @@ PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, con
   const auto& n = pair.nodes;
   const bool vf = pair.kind == ContactPair::VertexFace;
   N.col(0) = surface_normal(*surface.surface, *surface.around, tn, n[0], vf ? -1 : n[1]);
-  if (!vf) N.col(1) = surface_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
+  if (vf) return N;
+  N.col(1) = surface_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
+  N.col(2) = edge_face_normal(*surface.surface, *surface.around, tn, n[0], n[1]);
+  N.col(3) = edge_face_normal(*surface.surface, *surface.around, tn, n[2], n[3]);
   return N;
 }
 

@@ -139,7 +139,8 @@ PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface)
 
 /// The outward normals of a pair (surface_normal, from the triangle normals tn of the
 /// configuration wanted): a vertex-face pair's vertex normal (and 0), an edge-edge pair's
-/// normals of edge a and edge b; all 0 without a surface.
+/// normals of edge a and edge b and of their triangles in which they run a0 -> a1, b0 -> b1
+/// (edge_face_normal); all 0 without a surface.
 PairNormals pair_normals(const ContactPair& pair, const DcrSurface& surface, const TriangleNormals& tn);
 
 /// Resolves the penetrations of one step (DESIGN.md step 2). Nodal arrays are indexed by

@@ -204,4 +204,24 @@ Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around
   return n.norm() > 1e-9 * sum ? n : Vec3::Zero();
 }
 
+Vec3 edge_face_normal(const ContactSurface& surface, const VertexTriangles& around, const TriangleNormals& tn,
+                      Index from, Index to) {
+  SHATTER_REQUIRE(from >= 0 && static_cast<size_t>(from) < around.position.size() && around.position[from] >= 0 &&
+                      tn.normal.size() == surface.triangles.size(),
+                  "edge_face_normal: node " << from << " is not a vertex of the surface, or the triangle normals "
+                                            << "are not the surface's");
+  const auto k = static_cast<size_t>(around.position[from]);
+  int forward = 0, backward = 0;
+  Vec3 n = Vec3::Zero();
+  for (Index j = around.offsets[k]; j < around.offsets[k + 1]; ++j) {
+    const Index i = around.items[j];
+    const auto& t = surface.triangles[i];
+    for (int c = 0; c < 3; ++c) {
+      if (t[c] == from && t[(c + 1) % 3] == to) ++forward, n = tn.normal[i];
+      if (t[c] == to && t[(c + 1) % 3] == from) ++backward;
+    }
+  }
+  return forward == 1 && backward == 1 ? n : Vec3::Zero();
+}
+
 }  // namespace shatter

@@ -103,4 +103,11 @@ void triangle_normals(const ContactSurface& surface, std::span<const Vec3> x, st
 Vec3 surface_normal(const ContactSurface& surface, const VertexTriangles& around, const TriangleNormals& tn,
                     Index node, Index other = -1);
 
+/// The normal (x1 - x0) x (x2 - x0) (m^2, from tn) of the triangle in which the edge runs from
+/// `from` to `to`, when the edge has exactly two triangles, one each way (a closed, oriented
+/// surface); else 0. With the edge's surface_normal, the sum of both, it gives each triangle's
+/// normal, the edge's exact normal cone (kernels/dcr.hpp dcr_in_edge_cone).
+Vec3 edge_face_normal(const ContactSurface& surface, const VertexTriangles& around, const TriangleNormals& tn,
+                      Index from, Index to);
+
 }  // namespace shatter

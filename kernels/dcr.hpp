@@ -45,8 +45,11 @@ namespace shatter {
 /// The four points (columns, m) or velocities (m/s) of one contact pair.
 using PairPoints = Eigen::Matrix<double, 3, 4>;
 /// The outward surface normals of one pair at the start of the step (columns, any length,
-/// 0 = none): VertexFace: the vertex's (column 1 unused); EdgeEdge: edge a's and edge b's.
-using PairNormals = Eigen::Matrix<double, 3, 2>;
+/// 0 = none): VertexFace: the vertex's (columns 1-3 unused); EdgeEdge: edge a's and edge b's
+/// (the sums of their triangles' normals), then the normal of edge a's triangle in which the
+/// edge runs a0 -> a1 and that of edge b's in which it runs b0 -> b1 (0 unless the edge has
+/// exactly two triangles, one each way: its other triangle's normal is the sum less this one).
+using PairNormals = Eigen::Matrix<double, 3, 4>;
 /// One value per node of a pair, e.g. the inverse lumped masses (1/kg; 0 = fixed node).
 using PairWeights = Eigen::Vector4d;
 
@@ -254,6 +257,16 @@ inline double dcr_touch_tolerance(DcrPairKind kind, const PairPoints& X_old, con
 /// corner (whose averaged normal makes at most 55 degrees with any direction in it).
 inline constexpr double kDcrFacingTolerance = 0.2;
 
+/// Whether the direction c (perpendicular to the edge e) lies in the outward normal cone of an
+/// edge with two triangles, n1 the normal of the one in which the edge runs along e, n2 the
+/// other's: the planes through the edge that support the body locally. For a convex edge,
+/// (n1 x n2) . e > 0, it is the arc from n1 to n2 turning about e; a flat edge has only its
+/// face's normal (left to the averaged test of dcr_orientation), a concave one none. Sign
+/// tests only: no tolerance.
+inline bool dcr_in_edge_cone(const Vec3& e, const Vec3& n1, const Vec3& n2, const Vec3& c) {
+  return n1.cross(n2).dot(e) > 0 && n1.cross(c).dot(e) >= 0 && c.cross(n2).dot(e) >= 0;
+}
+
 /// Orientation s of the constraint g = s V (g > 0 admissible), or 0 when it cannot be told
 /// (the pair is then never a penetration). N: the pair's outward normals at X_old
 /// (PairNormals; 0 = none, as where the two sides of a sheet cancel).
@@ -264,9 +277,15 @@ inline constexpr double kDcrFacingTolerance = 0.2;
 ///    in that of the other: n_a . c >= kDcrFacingTolerance |n_a| |c| and
 ///    n_b . c <= -kDcrFacingTolerance |n_b| |c| (edge b on the +c side of edge a), or the
 ///    reverse. Moving edge b by d changes V by -d . c / 6, so s = -1 when b belongs on the
-///    +c side, +1 on the -c side; a missing normal leaves its condition out. When neither
-///    holds the plane cuts through a body and the pair is no constraint (s = 0; an edge
-///    sliding across it then has its end points and other edges caught by other pairs).
+///    +c side, +1 on the -c side; a missing normal leaves its condition out. The averaged
+///    normal stands for a cone of about 78 degrees; a sharp edge's cone (dihedral angle
+///    below about 24 degrees) is wider, so when that test decides nothing and both edges have
+///    their two triangles (N_2, N_3), the exact cones decide (dcr_in_edge_cone). When neither
+///    holds the plane cuts through a body next to its edge: there edge b, touching edge a,
+///    would already lie partly inside that body (a plane through a convex edge that does not
+///    support the body meets its interior in a half-plane bounded by the edge), so the
+///    bodies meet through other pairs first (an end point in a face, another edge) and this
+///    pair is no constraint (s = 0; docs/contact.md "Edge pairs the normals do not orient").
 ///    Without any normal: the sign of V(X_old), the side the edges start on (0 when they
 ///    start touching, |V| <= tol).
 /// With normals the orientation is a property of the bodies, not of the motion: a pair
@@ -275,7 +294,8 @@ inline constexpr double kDcrFacingTolerance = 0.2;
 inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const PairNormals& N,
                               double tol) {
   if (kind == DcrPairKind::VertexFace) return -1.0;
-  const Vec3 c = (X_old.col(1) - X_old.col(0)).cross(X_old.col(3) - X_old.col(2));
+  const Vec3 e_a = X_old.col(1) - X_old.col(0), e_b = X_old.col(3) - X_old.col(2);
+  const Vec3 c = e_a.cross(e_b);
   const Vec3 n_a = N.col(0), n_b = N.col(1);
   const double la = n_a.norm(), lb = n_b.norm();
   if (la > 0 || lb > 0) {
@@ -283,6 +303,11 @@ inline double dcr_orientation(DcrPairKind kind, const PairPoints& X_old, const P
     const double fa = n_a.dot(c), fb = n_b.dot(c), k = kDcrFacingTolerance * c.norm();
     if ((la == 0 || fa >= k * la) && (lb == 0 || fb <= -k * lb)) return -1.0;
     if ((la == 0 || fa <= -k * la) && (lb == 0 || fb >= k * lb)) return 1.0;
+    const Vec3 f_a = N.col(2), f_b = N.col(3);  // the triangles in which the edges run a0 -> a1, b0 -> b1
+    if (la == 0 || lb == 0 || f_a == Vec3::Zero() || f_b == Vec3::Zero()) return 0.0;
+    const Vec3 g_a = n_a - f_a, g_b = n_b - f_b;  // the edges' other triangles
+    if (dcr_in_edge_cone(e_a, f_a, g_a, c) && dcr_in_edge_cone(e_b, f_b, g_b, -c)) return -1.0;
+    if (dcr_in_edge_cone(e_a, f_a, g_a, -c) && dcr_in_edge_cone(e_b, f_b, g_b, c)) return 1.0;
     return 0.0;
   }
   const double V0 = pair_volume(X_old);

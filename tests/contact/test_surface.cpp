@@ -3,6 +3,7 @@
 // TET4 and TET10; bodies are tagged; add_triangles equals a rebuild.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <numbers>
 
@@ -202,3 +203,43 @@ TEST(ContactSurface, ExtendingAMeshSurfaceEqualsBuildingTheUnion) {
 }
 
 }  // namespace
+
+// edge_face_normal (DCR's exact edge cones, issue 18): on a meshed box, every surface edge's
+// triangle in which it runs a -> b and the one in which it runs b -> a add up to the edge's
+// surface_normal, and turning from the first to the second about a -> b is a convex or flat
+// edge: the 12 edges of the box turn by 90 degrees, the face diagonals by none.
+TEST(ContactSurface, EdgeFaceNormalsSplitTheEdgeNormalIntoItsTwoTriangles) {
+  ShapeSpec spec;
+  spec.shape = "box";
+  spec.size = Vec3(1.0, 0.8, 0.6);
+  spec.center = Vec3(0.3, -0.2, 0.1);
+  spec.element_size = 0.3;
+  const Mesh m = mesh_shape(spec, 0, 0, "test");
+  const ContactSurface s = build_contact_surface(m);
+  const VertexTriangles around = vertex_triangles(s);
+  const TriangleNormals tn = triangle_normals(s, m.reference);
+  auto on_face = [&](const Vec3& x) {  // how many of the box's planes x lies on
+    int k = 0;
+    for (int c = 0; c < 3; ++c)
+      k += std::abs(std::abs(x[c] - spec.center[c]) - spec.size[c] / 2) < 1e-9;
+    return k;
+  };
+  int box_edges = 0;
+  for (const auto& [a, b] : s.edges) {
+    const Vec3 f = edge_face_normal(s, around, tn, a, b), g = edge_face_normal(s, around, tn, b, a);
+    const Vec3 n = surface_normal(s, around, tn, a, b), e = m.reference[b] - m.reference[a];
+    ASSERT_GT(f.norm(), 0.0);
+    ASSERT_GT(g.norm(), 0.0);
+    EXPECT_LE((f + g - n).norm(), 1e-14 * (f.norm() + g.norm()));
+    const double turn = f.normalized().cross(g.normalized()).dot(e.normalized());  // sin of the turn
+    const bool box_edge = on_face(m.reference[a]) >= 2 && on_face(m.reference[b]) >= 2 &&
+                          std::abs(f.normalized().dot(g.normalized())) < 0.5;
+    if (box_edge) {
+      ++box_edges;
+      EXPECT_NEAR(turn, 1.0, 1e-12);
+    } else {
+      EXPECT_NEAR(turn, 0.0, 1e-12);
+    }
+  }
+  EXPECT_GE(box_edges, 12);
+}

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <iomanip>
+#include <numbers>
 #include <random>
 #include <span>
 #include <sstream>
@@ -82,8 +83,15 @@ const Vec3 kA(0, 0, 0), kB(1, 0, 0), kC(0, 1, 0);
 // Outward surface normals (PairNormals): a vertex of a body above the face, facing down; edge
 // a of a body above edge b (edge b's body below, facing up); none (the sign of V at the start
 // orients edge pairs, as on the two sides of a sheet).
-const PairNormals kVertexDown = (PairNormals() << Vec3(0, 0, -1), Vec3::Zero()).finished();
-const PairNormals kEdgeAAbove = (PairNormals() << Vec3(0, 0, -1), Vec3(0, 0, 1)).finished();
+// normals(n_a, n_b): the averaged normals only (no triangle of either edge given).
+PairNormals normals(const Vec3& n0, const Vec3& n1 = Vec3::Zero()) {
+  PairNormals N = PairNormals::Zero();
+  N.col(0) = n0;
+  N.col(1) = n1;
+  return N;
+}
+const PairNormals kVertexDown = normals(Vec3(0, 0, -1));
+const PairNormals kEdgeAAbove = normals(Vec3(0, 0, -1), Vec3(0, 0, 1));
 const PairNormals kNoNormals = PairNormals::Zero();
 
 }  // namespace
@@ -306,8 +314,8 @@ TEST(DcrDetect, EdgesStartingCrossedAreNotPulledTogether) {
 // crossed on the face's boundary). A vertex that faces the face is caught in both cases.
 TEST(DcrDetect, VertexOnTheEdgeOfASlidingFaceIsAGraze) {
   const Vec3 p(0, 0.3, 0);
-  const PairNormals up = (PairNormals() << Vec3(0, 0, 1), Vec3::Zero()).finished();
-  const PairNormals facing = (PairNormals() << Vec3(-1, 0, 0), Vec3::Zero()).finished();
+  const PairNormals up = normals(Vec3(0, 0, 1));
+  const PairNormals facing = normals(Vec3(-1, 0, 0));
   // Side face in the plane x = x0, outward +x, bottom edge on z = 0: counter-clockwise from +x.
   auto side = [&](double x0) { return points(p, Vec3(x0, 0, 0), Vec3(x0, 1, 0), Vec3(x0, 0, 1)); };
   for (const double x0 : {0.0, -0.01}) {  // touching at the start; crossed mid-step
@@ -323,17 +331,92 @@ TEST(DcrDetect, VertexOnTheEdgeOfASlidingFaceIsAGraze) {
 // cross, the segments touch at one instant: no penetration. So does a vertical edge whose
 // plane with the face's edge is vertical (it cuts through the body below: s = 0).
 TEST(DcrDetect, EdgeEndSlidingOverAnEdgeInItsFaceIsAGraze) {
-  const PairNormals normals = (PairNormals() << Vec3(0, 0, 1), Vec3(-1, 0, -1)).finished();
+  const PairNormals tilted = normals(Vec3(0, 0, 1), Vec3(-1, 0, -1));
   auto at = [](double x) {
     return points(Vec3(-0.1, -1, 0), Vec3(0.1, 1, 0), Vec3(x, 0, 0), Vec3(x - 0.5, 0, 0.5));
   };
-  EXPECT_FALSE(dcr_detect(EE, at(0.01), at(-0.03), normals).penetrating);
-  const PairNormals vertical = (PairNormals() << Vec3(0, 0, 1), Vec3(-1, 0, 0)).finished();
+  EXPECT_FALSE(dcr_detect(EE, at(0.01), at(-0.03), tilted).penetrating);
+  const PairNormals vertical = normals(Vec3(0, 0, 1), Vec3(-1, 0, 0));
   auto upright = [](double x) {
     return points(Vec3(-0.1, -1, 0), Vec3(0.1, 1, 0), Vec3(x, 0, 0), Vec3(x, 0, 1));
   };
   EXPECT_EQ(dcr_orientation(EE, upright(-0.01), vertical, 0.0), 0.0);
   EXPECT_FALSE(dcr_detect(EE, upright(-0.01), upright(0.03), vertical).penetrating);
+  // With the edges' triangles (edge a flat in its face, edge b the convex vertical edge of a
+  // box, faces -x and -y): the exact cones do not orient it either, the face's edge has no
+  // cone beyond its face's normal.
+  PairNormals faces = normals(Vec3(0, 0, 1), Vec3(-1, -1, 0));
+  faces.col(2) = Vec3(0, 0, 0.5);
+  faces.col(3) = Vec3(-1, 0, 0);
+  EXPECT_EQ(dcr_orientation(EE, upright(-0.01), faces, 0.0), 0.0);
+  EXPECT_FALSE(dcr_detect(EE, upright(-0.01), upright(0.03), faces).penetrating);
+  EXPECT_FALSE(dcr_detect(EE, upright(0.03), upright(-0.01), faces).penetrating);
+}
+
+// Edge pairs the averaged normals do not orient (issue 18): a thin blade (dihedral angle 20
+// degrees, edge a along x pointing down, faces' outward normals (0, +-cos 10, -sin 10)) and
+// the convex edge of a second body crossing it within one step, in the plane whose normal u
+// makes 79 degrees with the blade's averaged normal -z. u is inside the blade's normal cone
+// (80 degrees about -z), so the blade's edge can be touched there from outside, but outside
+// the averaged test's 78.5 degrees (kDcrFacingTolerance = 0.2 > cos 79 = 0.191): with the
+// averaged normals alone the pair is no constraint and the edges stay crossed. With each
+// edge's two triangles the exact cones orient it: resolved, both momenta kept to round-off
+// and, frictionless and elastic, the kinetic energy with the counterpart's work.
+TEST(DcrResolvePair, SharpEdgeCrossingOutsideTheAveragedConeIsResolved) {
+  const double deg = std::numbers::pi / 180;
+  const Vec3 u(0, std::sin(79 * deg), -std::cos(79 * deg));
+  const Vec3 e_b(0, -std::cos(79 * deg), -std::sin(79 * deg));  // x cross e_b = u
+  // Blade: the face in which edge a runs a0 -> a1 (+x) is the -y face (convex: f x g along +x).
+  const Vec3 f_a(0, -std::cos(10 * deg), -std::sin(10 * deg)), g_a(0, std::cos(10 * deg), -std::sin(10 * deg));
+  // Second body: a right-angled edge along e_b whose faces' normals are -u turned by -+45
+  // degrees about e_b; the one in which the edge runs b0 -> b1 first (f x g along e_b).
+  const Vec3 w = e_b.cross(-u);
+  Vec3 f_b = (-u - w) / std::sqrt(2.0), g_b = (-u + w) / std::sqrt(2.0);
+  if (f_b.cross(g_b).dot(e_b) < 0) std::swap(f_b, g_b);
+  PairNormals averaged = normals(f_a + g_a, f_b + g_b), exact = averaged;
+  exact.col(2) = f_a;
+  exact.col(3) = f_b;
+
+  // Edge b crosses edge a's middle: from 0.05 on the +u side to 0.05 on the -u side, sliding
+  // along x and turning; edge a moves too.
+  PairPoints X_old = points(Vec3(-1, 0, 0), Vec3(1, 0, 0), 0.05 * u - 0.6 * e_b, 0.05 * u + 0.7 * e_b);
+  PairPoints V = points(Vec3(0.02, 0, 0.01), Vec3(0.03, -0.01, 0), -0.1 * u + Vec3(-0.2, 0.01, 0),
+                        -0.1 * u + Vec3(-0.25, 0, 0.02));
+  const PairPoints X_new = X_old + V;  // dt = 1
+  const PairWeights w_inv(1 / 2.0, 1 / 3.0, 1 / 1.5, 1 / 2.5);
+  const double tol = dcr_touch_tolerance(EE, X_old, X_new);
+
+  EXPECT_EQ(dcr_orientation(EE, X_old, averaged, tol), 0.0);
+  const double s = dcr_orientation(EE, X_old, exact, tol);
+  ASSERT_EQ(s, -1.0);  // edge b belongs on the +c = +u side
+  EXPECT_LT(s * pair_volume(X_new), 0.0);
+  EXPECT_GE(dcr_inside_margin(EE, X_new), 0.0);  // crossed at the end of the step
+
+  // The edge of a concave fold with the same triangles' normals has no cone: still 0.
+  PairNormals concave = exact;
+  concave.col(2) = g_a;
+  EXPECT_EQ(dcr_orientation(EE, X_old, concave, tol), 0.0);
+
+  for (const DcrPlacement placement : {DcrPlacement::End, DcrPlacement::Middle}) {
+    SCOPED_TRACE(static_cast<int>(placement));
+    const DcrLaw law{1.0, 0.0, 1e-6, placement};
+    PairPoints Xa = X_new, Va = V;
+    EXPECT_FALSE(dcr_resolve_pair(EE, X_old, Xa, Va, averaged, w_inv, law, 0.5).active);
+    EXPECT_LT(s * pair_volume(Xa), 0.0);  // the averaged normals leave the edges crossed
+
+    PairPoints X = X_new, Vr = V;
+    const Ledger before = ledger(X_new, V, w_inv);
+    const DcrPairResponse out = dcr_resolve_pair(EE, X_old, X, Vr, exact, w_inv, law, 0.5);
+    ASSERT_TRUE(out.active);
+    EXPECT_TRUE(out.separated);
+    EXPECT_GT(s * pair_volume(X), 0.0);
+    const Ledger after = ledger(X, Vr, w_inv);
+    EXPECT_LE((after.p - before.p).norm(), 1e-12 * before.p_scale);
+    EXPECT_LE((after.L - before.L).norm(), 1e-12 * before.L_scale);
+    EXPECT_CLOSE(after.kinetic + out.work, before.kinetic, 1e-12, 0);
+    EXPECT_EQ(out.impulse.dissipated, 0.0);
+    EXPECT_GT(out.impulse.normal, 0.0);
+  }
 }
 
 // --- projection ------------------------------------------------------------------------
