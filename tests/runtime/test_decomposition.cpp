@@ -353,7 +353,9 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
       continue;
     }
     EXPECT_TRUE(in_element[n] || rigid) << "surface node " << surface.vertices[k] << " held outside the elements";
-    if (in_element[n]) EXPECT_EQ(p.surface_owner[k], d.node_owner(n));
+    if (in_element[n]) {
+      EXPECT_EQ(p.surface_owner[k], d.node_owner(n));
+    }
   }
   EXPECT_GT(surface_only_elsewhere, 0) << "every part held every surface node";
 }
