@@ -113,7 +113,9 @@ c0 = math.sqrt(E / rho)
 s0 = E * Gc / sc**2
 eps0 = c0 * sc**3 / (E**2 * Gc)
 grady = lambda r: (24 * Gc / (rho * r**2)) ** (1 / 3)
-zmr = lambda r: s0 * 4.5 / (1 + 4.5 * (r / eps0) ** (2 / 3))
+# ZMR for a toughness G (s0 and eps0 scale with G and 1 / G)
+zmr_g = lambda r, G: (E * G / sc**2) * 4.5 / (1 + 4.5 * (r / (c0 * sc**3 / (E**2 * G))) ** (2 / 3))
+zmr = lambda r: zmr_g(r, Gc)
 
 rows, hist, lengths = [], {}, {}
 for case in cases:
@@ -164,6 +166,10 @@ for case in cases:
         split_between=sm["crack_area_between_fragments"] / (max(big, 1) * A),
         split_inside=(sm["crack_area_debonded"] - sm["crack_area_between_fragments"]) / (max(big, 1) * A),
         split_partial=(diss - sm["cohesive_dissipated_debonded"]) / (Gc * max(big, 1) * A)))
+    # each through-crack debonds (between + inside) a^2 of facets, not a^2: ZMR
+    # with Gc times that ratio, the toughness per crack of the ring's cross-section
+    rows[-1]["debonded_per_crack"] = rows[-1]["split_between"] + rows[-1]["split_inside"]
+    rows[-1]["ratio_big_zmr_debonded_gc"] = s_big / zmr_g(rate, Gc * rows[-1]["debonded_per_crack"])
     hist[name] = (t, nf)
     lengths[name] = [l for l in Li if l >= h]
 
@@ -182,10 +188,11 @@ for r in rows:
           f"| {r['fragments']} ({r['fragments_big']}, {r['single_element']}) | {r['s_big']*1e3:.3f} | {r['s_mass']*1e3:.3f} | {r['zmr']*1e3:.3f} "
           f"| **{r['ratio_big_zmr']:.2f}** | {r['ratio_big_zmr_at_insertion']:.2f} | {r['ratio_big_grady']:.2f} | {r['dissipated_ratio_big']:.2f} | {r['energy_error']:.1e} | {r['wall_time']:.0f} |")
 print()
-print("| run | dissipated / (Gc N_big a^2) | through-cracks | debonded inside fragments | still cohesive (opened partway) |")
-print("|---|---|---|---|---|")
+print("| run | dissipated / (Gc N_big a^2) | through-cracks | debonded inside fragments | still cohesive (opened partway) | L/N_big / ZMR | L/N_big / ZMR with Gc x debonded area per crack |")
+print("|---|---|---|---|---|---|---|")
 for r in rows:
-    print(f"| {r['name']} | {r['dissipated_ratio_big']:.2f} | {r['split_between']:.2f} | {r['split_inside']:.2f} | {r['split_partial']:.2f} |")
+    print(f"| {r['name']} | {r['dissipated_ratio_big']:.2f} | {r['split_between']:.2f} | {r['split_inside']:.2f} | {r['split_partial']:.2f} "
+          f"| {r['ratio_big_zmr']:.2f} | {r['ratio_big_zmr_debonded_gc']:.2f} |")
 print()
 for r in rows:
     print(f"{r['name']}: first facet at {r['first_insertion']*1e6:.3f} us; last change of the count at {r['last_change']*1e6:.3f} us "
@@ -238,9 +245,15 @@ for k, rate in enumerate(rate_names):
         pool = sorted(l / z for r in rs for l in lengths[r["name"]])
         if not pool:
             continue
-        lab = (f"Weibull m = 8, {len(rs)} seeds" if w else "no scatter") + f" ({len(pool)} fragments)"
+        lab = (f"Weibull m = 8, seeds: {len(rs)}" if w else "no scatter") + f" ({len(pool)} fragments)"
         n = len(pool)
         mean = sum(pool) / n
+        std = math.sqrt(sum((x - mean) ** 2 for x in pool) / n)
+        # Kolmogorov-Smirnov distance to the Rayleigh distribution of mean m
+        ks = lambda m: max(max(abs((i + 1) / n - F), abs(i / n - F))
+                           for i, x in enumerate(pool) for F in [1 - math.exp(-math.pi * x * x / (4 * m * m))])
+        print(f"distribution {rate:.0e} /s, h = {hw[0]*1e6:.0f} um, {lab}: mean / ZMR {mean:.3f}, std / mean {std / mean:.3f} "
+              f"(Rayleigh 0.523), KS distance to Rayleigh with ZMR's mean {ks(1.0):.3f}, with its own mean {ks(mean):.3f}")
         a_.step(pool, [(i + 1) / n for i in range(n)], where="post", color=f"C{j}", label=lab + f", mean {mean:.2f}")
         a_.plot(xs, [1 - math.exp(-math.pi * x * x / (4 * mean * mean)) for x in xs], "--", color=f"C{j}", lw=0.8, label="Rayleigh, that mean")
     a_.set_xlim(0, 4)
