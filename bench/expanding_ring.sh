@@ -33,7 +33,8 @@
 # Output:  bench/results/expanding_ring.csv, docs/plots/expanding_ring.png,
 #          docs/plots/expanding_ring_distribution.png, tables on stdout.
 # Expect:  see docs/validation.md ("Three rates, three meshes, scatter"):
-#          L/N_big 1.1-1.5 x ZMR. Every run is niced (nice -n 15), one thread;
+#          L/N_big 1.15-1.55 x ZMR, 1.4-2.1 with scatter. Every run is niced
+#          (nice -n 15), one thread;
 #          the costliest are r1e4_h50 (54k tets) and r1e5_h25 (109k tets),
 #          several CPU minutes each.
 set -euo pipefail
