@@ -69,7 +69,9 @@ def metrics(d, v):
                 force_error=f_peak / f_h - 1)
 
 
-def run(build, v, H, h, r, order):
+def case_sets(v, H, h, r, order):
+    """The --set list of one case: mesh, speeds, a gap of 0.4 us of approach, 1.3 t_c after it,
+    and the refinement at the contact point."""
     sets = [f"bodies[{b}].mesh.element_size={H}" for b in (0, 1)]
     sets += [f"bodies[{b}].mesh.order={order}" for b in (0, 1)]
     sets += [f"bodies[0].initial_velocity=[{v / 2},0,0]", f"bodies[1].initial_velocity=[{-v / 2},0,0]"]
@@ -79,15 +81,25 @@ def run(build, v, H, h, r, order):
     sets += [f"time.end={gap / v + 1.3 * t_h}"]
     if h < H and r > 0:
         sets += [f"bodies[{b}].mesh.refine=[{{center: [0, 0, 0], radius: {r}, element_size: {h}}}]" for b in (0, 1)]
+    return sets
+
+
+def run_shatter(build, sets, d):
+    """Runs the scene with `sets` into folder d at --threads 1 under nice; returns its CPU time, s
+    (user + system, meshing included)."""
+    cmd = ["nice", "-n", "15", os.path.join(build, "apps", "shatter"), "run", SCENE, "--out", d, "--threads", "1",
+           "--quiet"]
+    for s in sets:
+        cmd += ["--set", s]
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True)
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return cpu1.ru_utime + cpu1.ru_stime - cpu0.ru_utime - cpu0.ru_stime
+
+
+def run(build, v, H, h, r, order):
     with tempfile.TemporaryDirectory() as d:
-        cmd = ["nice", "-n", "15", os.path.join(build, "apps", "shatter"), "run", SCENE, "--out", d, "--threads", "1",
-               "--quiet"]
-        for s in sets:
-            cmd += ["--set", s]
-        cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        subprocess.run(cmd, check=True)
-        cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = cpu1.ru_utime + cpu1.ru_stime - cpu0.ru_utime - cpu0.ru_stime
+        cpu = run_shatter(build, case_sets(v, H, h, r, order), d)
         s = json.load(open(os.path.join(d, "summary.json")))
         row = dict(v=v, H=H, h=h, r=r, order=order, elements=s["elements"], steps=s["steps"])
         row.update(metrics(d, v))
