@@ -81,19 +81,14 @@ def run(build, v, H, h, r, order, safety):
 
 
 def main():
-    build, cases = sys.argv[1], sys.argv[2:]
-    out = None
-    for c in cases:
-        f = c.split(":")
-        v, H, h, r = (float(x) for x in f[:4])
-        order = int(f[4]) if len(f) > 4 else 1
-        safety = float(f[5]) if len(f) > 5 and f[5] else None
-        row = run(build, v, H, h, r, order, safety)
-        if out is None:
-            out = csv.DictWriter(sys.stdout, fieldnames=list(row))
-            out.writeheader()
-        out.writerow({k: (f"{x:.5g}" if isinstance(x, float) else x) for k, x in row.items()})
-        sys.stdout.flush()
+    build = sys.argv[1]
+
+    def case(v, H, h, r, more):
+        order = int(more[0]) if more else 1
+        safety = float(more[1]) if len(more) > 1 and more[1] else None
+        return run(build, v, H, h, r, order, safety)
+
+    hr.rows_to_csv(sys.argv[2:], case, 5)
 
 
 if __name__ == "__main__":

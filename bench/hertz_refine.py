@@ -107,18 +107,24 @@ def run(build, v, H, h, r, order):
         return row
 
 
-def main():
-    build, cases = sys.argv[1], sys.argv[2:]
+def rows_to_csv(cases, run_case, digits):
+    """Each case "v:H:h:r[:more...]" run by run_case(v, H, h, r, more) as one CSV row on
+    stdout (numbers to `digits` significant digits), the header first."""
     out = None
     for c in cases:
         f = c.split(":")
         v, H, h, r = (float(x) for x in f[:4])
-        row = run(build, v, H, h, r, int(f[4]) if len(f) > 4 else 1)
+        row = run_case(v, H, h, r, f[4:])
         if out is None:
             out = csv.DictWriter(sys.stdout, fieldnames=list(row))
             out.writeheader()
-        out.writerow({k: (f"{x:.6g}" if isinstance(x, float) else x) for k, x in row.items()})
+        out.writerow({k: (f"{x:.{digits}g}" if isinstance(x, float) else x) for k, x in row.items()})
         sys.stdout.flush()
+
+
+def main():
+    build = sys.argv[1]
+    rows_to_csv(sys.argv[2:], lambda v, H, h, r, more: run(build, v, H, h, r, int(more[0]) if more else 1), 6)
 
 
 if __name__ == "__main__":
