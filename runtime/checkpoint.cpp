@@ -451,17 +451,15 @@ struct Reader {
                          std::span<const char> counted) const {
     return array<Vec3>(group, name, expected, 3, keep, counted);
   }
-  /// Rank `rank`'s block of such a dataset, of `ranks` blocks: its rows [N rank / ranks,
-  /// N (rank + 1) / ranks), into `out`; returns the first. The block's rows are hashed here
-  /// (over the ranks, every row once).
+  /// Rank `rank`'s block of such a dataset, of `ranks` blocks (block_firsts). The block's
+  /// rows are hashed here (over the ranks, every row once).
   template <class T>
-  std::size_t block(hid_t group, const char* name, std::size_t expected, hsize_t cols, int rank, int ranks,
-                    std::vector<T>& out) const {
-    const std::size_t first = expected * rank / ranks, last = expected * (rank + 1) / ranks;
-    std::vector<Index> keep(last - first);
-    std::iota(keep.begin(), keep.end(), static_cast<Index>(first));
-    out = array<T>(group, name, expected, cols, keep, std::vector<char>(keep.size(), 1));
-    return first;
+  std::vector<T> block(hid_t group, const char* name, std::size_t expected, hsize_t cols, int rank,
+                       int ranks) const {
+    const std::vector<std::size_t> first = block_firsts(expected, ranks);
+    std::vector<Index> keep(first[rank + 1] - first[rank]);
+    std::iota(keep.begin(), keep.end(), static_cast<Index>(first[rank]));
+    return array<T>(group, name, expected, cols, keep, std::vector<char>(keep.size(), 1));
   }
   /// The datasets read in part: each rank's sums of its counted rows, added
   /// over the ranks of `comm` (one reduction) and checked against the stored hashes.
@@ -874,9 +872,9 @@ void read_fracture_part(const Reader& r, hid_t fr, const Model& model, std::size
     f.bc_velocity = r.rows(fr, "bc_velocity", n, rows, counted);
     f.bc_condition = r.array<std::array<std::int32_t, 3>>(fr, "bc_condition", n, 3, rows, counted);
     f.initial_velocity = r.rows(fr, "initial_velocity", n, rows, counted);
-    r.block(fr, "bc_mask", n, 1, rank, ranks, bc_block);
-    r.block(fr, "facet_gid", facets, 1, rank, ranks, facet_block);
-    r.block(fr, "cohesive_facet", nc, 1, rank, ranks, cohesive_block);
+    bc_block = r.block<std::uint8_t>(fr, "bc_mask", n, 1, rank, ranks);
+    facet_block = r.block<GlobalId>(fr, "facet_gid", facets, 1, rank, ranks);
+    cohesive_block = r.block<GlobalId>(fr, "cohesive_facet", nc, 1, rank, ranks);
     r.require(std::is_sorted(facet_block.begin(), facet_block.end()),
               "/fracture/facet_gid is not ascending (corrupted checkpoint?)");
   } catch (const InputError& e) {

@@ -119,6 +119,8 @@ class ContactPatch {
   /// Patch node k's surface vertex, and its node in the part (-1 if not held there).
   Index surface_vertex(Index k) const { return nodes_[k]; }
   Index part_node(Index k) const { return vertices_.node[nodes_[k]]; }
+  /// The surface vertex whose whole id is `whole` (it must be one).
+  Index vertex(Index whole) const;
   /// The patch node whose whole id is `whole` (it must be one), and patch node k's whole id.
   Index node(Index whole) const;
   Index whole(Index k) const { return vertices_.whole[nodes_[k]]; }
@@ -184,8 +186,6 @@ class ContactPatch {
   void sort_marked(std::vector<Index>& nodes);
   /// The surface index of the edge {a, b} (a < b, surface vertex ids).
   Index edge(Index a, Index b) const;
-  /// The surface vertex whose whole id is `whole` (it must be one).
-  Index vertex(Index whole) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;

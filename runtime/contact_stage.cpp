@@ -313,9 +313,7 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   u.kind = first->kind;
   std::array<long, 4> gid{};
   for (int c = 0; c < 4; ++c) {
-    const Index whole = first->nodes[c];
-    const auto v = std::lower_bound(vertices_.whole.begin(), vertices_.whole.end(), whole) - vertices_.whole.begin();
-    SHATTER_ASSERT(static_cast<size_t>(v) < vertices_.whole.size() && vertices_.whole[v] == whole);
+    const Index v = patch_->vertex(first->nodes[c]);
     u.body[c] = vertices_.body[v];
     const Index n = vertices_.node[v];
     gid[c] = n >= 0 && dec_->owns_node(n) ? model_.mesh.node_gid[n] : -1;
