@@ -122,6 +122,30 @@ for r in rows:
     print(f"{r['name']}: first facet at {r['first_insertion']*1e6:.3f} us; last change of the count at {r['last_change']*1e6:.3f} us "
           f"of {r['end_time']*1e6:.2f} us; count at 70 % of the run {r['fragments_at_70pct']}, at the end {r['fragments']}")
 
+# one line per run: what issue 19's done-when 2 asks for
+print()
+print("| run | rate 1/s | h um | ZMR/h | tets | scatter, seed | N (N_big) | L/N_big / ZMR | through-crack area / a^2 | debonded area per crack / a^2 | dissipated / (Gc N_big a^2) | energy error |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+for r in rows:
+    print(f"| {r['name']} | {r['rate']:.0e} | {r['h']*1e6:.0f} | {r['zmr_over_h']:.1f} | {r['elements']} | {scatter_label(r['scatter'])}{', ' + r['seed'] if r['seed'] else ''} "
+          f"| {r['fragments']} ({r['fragments_big']}) | **{r['ratio_big_zmr']:.2f}** | {r['split_between']:.2f} | {r['debonded_per_crack']:.2f} "
+          f"| {r['dissipated_ratio_big']:.2f} | {r['energy_error']:.1e} |")
+
+# runs of one rate, mesh and scatter with different seeds: the seed's sample
+# of strengths moves the count, so a mesh's size is the mean over its seeds
+# (min and max beside it)
+groups = {}
+for r in rows:
+    groups.setdefault((r["rate"], r["h"], r["scatter"]), []).append(r)
+print()
+print("| rate 1/s | h um | ZMR/h | scatter | seeds | L/N_big / ZMR, mean over seeds | min - max | through-crack area / a^2 | debonded area per crack / a^2 | dissipated / (Gc N_big a^2) |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+for (rate, h, scat), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][2], -kv[0][1])):
+    mean = lambda key: sum(r[key] for r in rs) / len(rs)
+    q = [r["ratio_big_zmr"] for r in rs]
+    print(f"| {rate:.0e} | {h*1e6:.0f} | {rs[0]['zmr_over_h']:.1f} | {scatter_label(scat)} | {len(rs)} | **{mean('ratio_big_zmr'):.2f}** | {min(q):.2f} - {max(q):.2f} "
+          f"| {mean('split_between'):.2f} | {mean('debonded_per_crack'):.2f} | {mean('dissipated_ratio_big'):.2f} |")
+
 # size against rate, convergence with ZMR/h, counts against time
 rate_names = sorted({r["rate"] for r in rows})
 fig, ax = plt.subplots(1, 3, figsize=(16, 4.8))
@@ -136,8 +160,12 @@ ax[0].plot([], [], "ko", label=f"L/N_big, {scatter_label(main_scatter)}")
 ax[0].plot([], [], "k^", mfc="none", label="L/N_big, other scatter")
 ax[0].set_xlabel("strain rate, 1/s"); ax[0].set_ylabel("mean fragment size, mm"); ax[0].legend(fontsize=8)
 for k, rate in enumerate(rate_names):
-    rs = sorted((r for r in rows if r["rate"] == rate and r["scatter"] == main_scatter), key=lambda r: r["zmr_over_h"])
-    ax[1].plot([r["zmr_over_h"] for r in rs], [r["ratio_big_zmr"] for r in rs], "o-", color=f"C{k}", label=f"{rate:.0e} /s")
+    gs = sorted((g for key, g in groups.items() if key[0] == rate and key[2] == main_scatter), key=lambda g: g[0]["zmr_over_h"])
+    x = [g[0]["zmr_over_h"] for g in gs]
+    m = [sum(r["ratio_big_zmr"] for r in g) / len(g) for g in gs]
+    lo = [mi - min(r["ratio_big_zmr"] for r in g) for mi, g in zip(m, gs)]
+    hi = [max(r["ratio_big_zmr"] for r in g) - mi for mi, g in zip(m, gs)]
+    ax[1].errorbar(x, m, yerr=[lo, hi], fmt="o-", capsize=3, color=f"C{k}", label=f"{rate:.0e} /s (mean of seeds, min-max)")
     ws = [r for r in rows if r["rate"] == rate and r["scatter"] != main_scatter]
     ax[1].plot([r["zmr_over_h"] for r in ws], [r["ratio_big_zmr"] for r in ws], "^", color=f"C{k}", mfc="none")
 ax[1].axhspan(0.9, 1.1, color="0.9", label="ZMR +- 10 %")
