@@ -11,6 +11,7 @@
 #include "runtime/contact_partition.hpp"
 #include "runtime/contact_patch.hpp"
 #include "runtime/decomposition.hpp"
+#include "runtime/named_surface.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/patch_ranks.hpp"
 #include "runtime/timed.hpp"
@@ -196,19 +197,12 @@ void ContactStage::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
 // candidates + 0.01 (the filter's work, and a bound on DCR's; balanced alone,
 // one rank of two held 60 % of the 76 cubes' triangles and searched 1.3x
 // longer than the other). Before the first partition a primitive
-// belongs to the volume owner of its first node. The primitives are
+// belongs to its first owner (first_owned). The primitives are
 // re-partitioned at a search (i.e. when the surface moved past the reuse margin)
 // if the surface was rebuilt, or if the candidates per rank are out of balance by
 // more than 10 % (largest over mean), and then searched again.
 void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  if (!patch_->owned_any()) {
-    std::vector<Index> first_owned;
-    for (Index q = 0; q < nt + static_cast<Index>(surface_.edges.size()); ++q)
-      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
-        first_owned.push_back(q);
-    patch_->own(first_owned);
-  }
+  if (!patch_->owned_any()) patch_->own(first_owned());
   // The owned primitives' states start the search (their boxes, the reach).
   exchange(x_old, x_new, v, PatchPlan::Owned);
   for (bool repartitioned = false;; repartitioned = true) {
@@ -240,6 +234,40 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   }
   patch_->activate(pairs_);
   exchange(x_old, x_new, v, PatchPlan::Active);
+}
+
+std::vector<Index> ContactStage::first_owned() const {
+  const auto nt = static_cast<Index>(surface_.triangles.size()), ne = static_cast<Index>(surface_.edges.size());
+  std::vector<Index> owned;
+  if (!model_.is_part()) {
+    // A whole model on ranks (shells, cracks in contact): the volume owner of each
+    // primitive's first node.
+    for (Index q = 0; q < nt + ne; ++q)
+      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
+        owned.push_back(q);
+    return owned;
+  }
+  // A part: the primitives it names (owned_surface), found in the replicated surface, which
+  // lists triangles in name order and edges ascending, as the names come.
+  const NamedSurface mine = owned_surface(model_, *dec_);
+  const std::vector<Index>& whole = vertices_.whole;
+  Index t = 0;
+  for (const NamedTriangle& named : mine.triangles) {
+    const auto same = [&](Index i) {
+      const auto& n = surface_.triangles[i];
+      return whole[n[0]] == named.nodes[0] && whole[n[1]] == named.nodes[1] && whole[n[2]] == named.nodes[2];
+    };
+    while (t < nt && !same(t)) ++t;
+    SHATTER_ASSERT(t < nt);
+    owned.push_back(t++);
+  }
+  Index e = 0;
+  for (const auto& [a, b] : mine.edges) {
+    while (e < ne && (whole[surface_.edges[e][0]] != a || whole[surface_.edges[e][1]] != b)) ++e;
+    SHATTER_ASSERT(e < ne);
+    owned.push_back(nt + e++);
+  }
+  return owned;
 }
 
 std::vector<Index> ContactStage::partition() {

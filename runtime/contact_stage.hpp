@@ -164,6 +164,10 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine` (patch ids), in
   /// whole ids, named in unresolved_ (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine);
+  /// The primitives owned here before the first partition (numbered as in ContactPatch::own):
+  /// on a part, those it names (owned_surface: a triangle by its element's owner, an edge by
+  /// its smallest-named triangle's); on a whole model, each by the volume owner of its first node.
+  std::vector<Index> first_owned() const;
   /// The primitives owned here after an RCB partition of the owned ones at the patch's
   /// x(n+1), weighted by their candidates.
   std::vector<Index> partition();
