@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <limits>
 #include <map>
-#include <numeric>
 
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
@@ -54,10 +53,6 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
       part_reach_(node_reach) {
   SHATTER_REQUIRE(vertices.whole.size() == surface.vertices.size(),
                   "ContactPatch: " << vertices.whole.size() << " nodes for " << surface.vertices.size() << " vertices");
-  // The edges are sorted by their first node, so each vertex's are a range.
-  edge_offsets_.assign(surface.vertices.size() + 1, 0);
-  for (const auto& e : surface.edges) ++edge_offsets_[around.position[e[0]] + 1];
-  std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
   for (Index k = 0; k < surface.num_vertices(); ++k) {
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
@@ -92,17 +87,11 @@ Index ContactPatch::node(Index whole) const {
   return k;
 }
 
-Index ContactPatch::edge(Index a, Index b) const {
-  const Index at = around_.position[a];
-  const auto first = surface_.edges.begin() + edge_offsets_[at], last = surface_.edges.begin() + edge_offsets_[at + 1];
-  const auto it = std::find(first, last, std::array<Index, 2>{a, b});
-  SHATTER_ASSERT(it != last);
-  return static_cast<Index>(it - surface_.edges.begin());
-}
-
-Index ContactPatch::surface_primitive(Index q) const {
-  const auto nt = static_cast<Index>(owned_triangles_.size());
-  return q < nt ? owned_triangles_[q] : surface_.num_triangles() + patch_edges_[q - nt];
+Index ContactPatch::owned_primitive(Index q) const {
+  const Index nt = owned_.num_triangles();
+  if (q < nt) return q;
+  const Index e = patch_edge_owned_at_[q - nt];
+  return e < 0 ? -1 : nt + e;
 }
 
 namespace {
@@ -146,28 +135,18 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
     if (plans_[p]) plans_[p] = halo_of(lists_[p]);
 }
 
-void ContactPatch::own(std::span<const Index> primitives) {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  const auto total = nt + static_cast<Index>(surface_.edges.size());
+void ContactPatch::own(const NamedSurface& primitives) {
   owned_once_ = true;
-  owned_triangles_.clear();
-  owned_edges_.clear();
-  owned_mark_.assign(total, 0);
   ContactSurface owned;
-  for (size_t k = 0; k < primitives.size(); ++k) {
-    const Index q = primitives[k];
-    SHATTER_REQUIRE(q >= 0 && q < total && (k == 0 || primitives[k - 1] < q),
-                    "ContactPatch: primitive " << q << " of " << total << " out of range or out of order");
-    owned_mark_[q] = 1;
-    if (q < nt) {
-      owned_triangles_.push_back(q);
-      owned.triangles.push_back(surface_.triangles[q]);
-      owned.body.push_back(surface_.body[q]);
-    } else {
-      owned_edges_.push_back(q - nt);
-      owned.edges.push_back(surface_.edges[q - nt]);
-    }
+  for (const NamedTriangle& t : primitives.triangles) {
+    owned.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    owned.body.push_back(t.body);
   }
+  for (const auto& [a, b] : primitives.edges) owned.edges.push_back({vertex(a), vertex(b)});
+  SHATTER_REQUIRE(std::is_sorted(owned.edges.begin(), owned.edges.end()) &&
+                      std::adjacent_find(owned.edges.begin(), owned.edges.end()) == owned.edges.end(),
+                  "ContactPatch: owned edges not ascending");
+  owned_edges_ = owned.edges;
   add_nodes<3>(owned.triangles, owned.vertices);
   add_nodes<2>(owned.edges, owned.vertices);
   sort_unique(owned.vertices);
@@ -212,7 +191,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
                 Vec3(reach[6 * r + 3], reach[6 * r + 4], reach[6 * r + 5])};
   // Edges as their nodes' whole ids {a, b}, vertices as -(whole id + 1).
   std::vector<std::vector<Index>> to(ranks);
-  for (size_t k = 0; k < owned_edges_.size(); ++k)
+  for (size_t k = 0; k < owned_.edges.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r]))
         for (const Index n : owned_.edges[k]) to[r].push_back(whole(n));
@@ -220,11 +199,13 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
     for (int r = 0; r < ranks; ++r)
       if (boxes_overlap(home.vertices[k], boxes[r]))
         to[r].push_back(-(model_.whole_node(volume_vertices_.vertices[k]) + 1));
-  std::vector<Index> edges(owned_edges_), vertices;
+  // The patch's edges in surface vertex ids.
+  std::vector<std::array<Index, 2>> edges(owned_edges_);
+  std::vector<Index> vertices;
   for (const auto& list : dec_.alltoall(to))
     for (size_t at = 0; at < list.size(); ++at)
       if (list[at] < 0) vertices.push_back(vertex(-list[at] - 1));
-      else edges.push_back(edge(vertex(list[at]), vertex(list[at + 1]))), ++at;
+      else edges.push_back({vertex(list[at]), vertex(list[at + 1])}), ++at;
   sort_unique(edges);
   sort_unique(vertices);
   // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
@@ -232,10 +213,10 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   // triangles around them, whose normals orient their pairs (activate()).
   node_mark_.resize(surface_.vertices.size(), 0);
   std::vector<Index> needed;
-  for (const Index t : owned_triangles_)
-    for (const Index n : surface_.triangles[t]) add_node(n, needed);
-  for (const Index e : edges)
-    for (const Index n : surface_.edges[e]) add_node(n, needed);
+  for (const auto& t : owned_.triangles)
+    for (const Index n : t) add_node(nodes_[n], needed);
+  for (const auto& e : edges)
+    for (const Index n : e) add_node(n, needed);
   for (const Index n : vertices) add_node(n, needed);
   std::vector<Index> nodes = needed;
   for (const Index n : kept_) add_node(n, nodes);
@@ -254,14 +235,16 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_ = {};
   patch_.triangles = owned_.triangles;
   patch_.body = owned_.body;
-  for (const Index e : edges) {
-    const auto& [a, b] = surface_.edges[e];
+  patch_edge_owned_at_.clear();
+  patch_edge_owned_.clear();
+  for (const auto& [a, b] : edges) {
     patch_.edges.push_back({position_[a], position_[b]});
+    const auto it = std::lower_bound(owned_edges_.begin(), owned_edges_.end(), std::array<Index, 2>{a, b});
+    const bool owned = it != owned_edges_.end() && *it == std::array<Index, 2>{a, b};
+    patch_edge_owned_at_.push_back(owned ? static_cast<Index>(it - owned_edges_.begin()) : -1);
+    patch_edge_owned_.push_back(owned ? 1 : 0);
   }
   for (const Index n : vertices) patch_.vertices.push_back(position_[n]);
-  patch_edges_ = std::move(edges);
-  patch_edge_owned_.resize(patch_edges_.size());
-  for (size_t k = 0; k < patch_edges_.size(); ++k) patch_edge_owned_[k] = owns(surface_.num_triangles() + patch_edges_[k]);
   auto& lists = lists_[static_cast<int>(PatchPlan::Patch)];
   lists = plan(needed, false);
   plans_[static_cast<int>(PatchPlan::Patch)] = halo_of(lists);

@@ -25,6 +25,7 @@
 #include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
 #include "contact/surface.hpp"
+#include "runtime/named_surface.hpp"
 
 namespace shatter {
 
@@ -68,17 +69,13 @@ class ContactPatch {
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
 
-  /// A new ownership: the primitives this rank owns, ascending (triangle t as t, edge e as
-  /// the number of triangles + e); no rank learns the others'. Plans the states of the owned
+  /// A new ownership: the triangles and edges this rank owns, named (triangles in name
+  /// order, edges ascending); no rank learns the others'. Plans the states of the owned
   /// primitives' nodes (PatchPlan::Owned; collective).
-  void own(std::span<const Index> primitives);
+  void own(const NamedSurface& primitives);
   bool owned_any() const { return owned_once_; }
-  /// Whether this rank owns primitive q (numbered as in own()).
-  bool owns(Index q) const { return owned_mark_[q] != 0; }
-  /// The triangles and edges owned here (surface indices, ascending) and their nodes
-  /// (patch node ids).
-  std::span<const Index> owned_triangles() const { return owned_triangles_; }
-  std::span<const Index> owned_edges() const { return owned_edges_; }
+  /// The owned triangles and edges, in own()'s order, in patch node ids. Owned primitive k is
+  /// triangle k, or edge k - the number of triangles.
   const ContactSurface& owned() const { return owned_; }
 
   /// The ghosts for a search over x_old -> x_new (the part's arrays: its home vertices'
@@ -100,8 +97,9 @@ class ContactPatch {
   /// The patch's inflated boxes for the search (inflated_boxes of patch(), with the owned
   /// primitives' from reach(); their states must be unchanged since, the rest here).
   SweptBoxes patch_boxes(double margin) const;
-  /// The primitive (numbered as in own()) of a primitive of patch() (as in OwnedPairs).
-  Index surface_primitive(Index patch_primitive) const;
+  /// The owned primitive (numbered as in owned()) of a primitive of patch() (as in
+  /// OwnedPairs), -1 for a ghost edge.
+  Index owned_primitive(Index patch_primitive) const;
   /// The triangles whose normals the active pairs read (those around their nodes), in
   /// surface order, and their vertices (no edges), with their vertex -> triangle lists
   /// (patch node ids).
@@ -184,8 +182,6 @@ class ContactPatch {
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
-  /// The surface index of the edge {a, b} (a < b, surface vertex ids).
-  Index edge(Index a, Index b) const;
 
   const Decomposition& dec_;
   const ContactSurface& surface_;
@@ -194,15 +190,13 @@ class ContactPatch {
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
-  std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
   std::vector<Index> kept_;   ///< the surface vertices whose part rows the time loop keeps (load())
   bool owned_once_ = false;
-  std::vector<Index> owned_triangles_, owned_edges_;
-  std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
+  std::vector<std::array<Index, 2>> owned_edges_;  ///< owned_.edges in surface vertex ids (ascending)
   ContactSurface owned_, patch_;
   SweptBoxes owned_boxes_;                  ///< inflated boxes of owned_ at the last reach()
-  std::vector<Index> patch_edges_;          ///< per edge of patch_: its surface index
+  std::vector<Index> patch_edge_owned_at_;      ///< per edge of patch_: its owned edge, -1 for a ghost
   std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
   ContactSurface normals_;
   VertexTriangles normals_around_;

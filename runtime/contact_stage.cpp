@@ -111,7 +111,6 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
   patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, vertices_, model_, mesh.num_nodes(),
                                           reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, *dec_);
-  weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
 
@@ -202,12 +201,12 @@ void ContactStage::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
 // if the surface was rebuilt, or if the candidates per rank are out of balance by
 // more than 10 % (largest over mean), and then searched again.
 void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
-  if (!patch_->owned_any()) patch_->own(first_owned());
+  if (!patch_->owned_any()) own(first_owned());
   // The owned primitives' states start the search (their boxes, the reach).
   exchange(x_old, x_new, v, PatchPlan::Owned);
   for (bool repartitioned = false;; repartitioned = true) {
     if (repartition_) {
-      patch_->own(partition());
+      partition();
       exchange(x_old, x_new, v, PatchPlan::Owned);
       repartition_ = false;
       ++profile_.repartitions;
@@ -224,7 +223,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     for (size_t k = 0; k < found.pairs.size(); ++k) {
       if (excluded(surface_pair(found.pairs[k]))) continue;
       pairs_.push_back(found.pairs[k]);
-      weight_[patch_->surface_primitive(found.primitive[k])] += 1.0f;
+      weight_[patch_->owned_primitive(found.primitive[k])] += 1.0f;
     }
     profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
     const long mine = static_cast<long>(pairs_.size());
@@ -236,59 +235,81 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
-std::vector<Index> ContactStage::first_owned() const {
-  const auto nt = static_cast<Index>(surface_.triangles.size()), ne = static_cast<Index>(surface_.edges.size());
-  std::vector<Index> owned;
-  if (!model_.is_part()) {
-    // A whole model on ranks (shells, cracks in contact): the volume owner of each
-    // primitive's first node.
-    for (Index q = 0; q < nt + ne; ++q)
-      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
-        owned.push_back(q);
-    return owned;
-  }
-  // A part: the primitives it names (owned_surface), found in the replicated surface, which
-  // lists triangles in name order and edges ascending, as the names come.
-  const NamedSurface mine = owned_surface(model_, *dec_);
+NamedSurface ContactStage::first_owned() const {
+  if (model_.is_part()) return owned_surface(model_, *dec_);
+  // A whole model on ranks (shells, cracks in contact): each primitive by the volume owner
+  // of its first node, a triangle named by its place in the surface (t, 0, 0).
+  NamedSurface owned;
   const std::vector<Index>& whole = vertices_.whole;
-  Index t = 0;
-  for (const NamedTriangle& named : mine.triangles) {
-    const auto same = [&](Index i) {
-      const auto& n = surface_.triangles[i];
-      return whole[n[0]] == named.nodes[0] && whole[n[1]] == named.nodes[1] && whole[n[2]] == named.nodes[2];
-    };
-    while (t < nt && !same(t)) ++t;
-    SHATTER_ASSERT(t < nt);
-    owned.push_back(t++);
+  for (Index t = 0; t < surface_.num_triangles(); ++t) {
+    const auto& n = surface_.triangles[t];
+    if (patch_->vertex_owner(n[0]) == dec_->rank())
+      owned.triangles.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
   }
-  Index e = 0;
-  for (const auto& [a, b] : mine.edges) {
-    while (e < ne && (whole[surface_.edges[e][0]] != a || whole[surface_.edges[e][1]] != b)) ++e;
-    SHATTER_ASSERT(e < ne);
-    owned.push_back(nt + e++);
-  }
+  for (const auto& [a, b] : surface_.edges)
+    if (patch_->vertex_owner(a) == dec_->rank()) owned.edges.push_back({whole[a], whole[b]});
   return owned;
 }
 
-std::vector<Index> ContactStage::partition() {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  const ContactSurface& owned = patch_->owned();
+void ContactStage::partition() {
+  // Each primitive as its name (4 words: kind, then a triangle's name or an edge's nodes),
+  // its centre at the patch's x(n+1) and its weights.
+  const ContactSurface& at = patch_->owned();
   const std::span<const Vec3> x = patch_->x_new();
-  std::vector<Index> ids;
+  const size_t nt = owned_.triangles.size(), ne = owned_.edges.size();
+  std::vector<Index> names;
   std::vector<Vec3> points;
   std::vector<float> weights;
-  for (size_t k = 0; k < owned.triangles.size(); ++k) {
-    const auto& n = owned.triangles[k];
-    ids.push_back(patch_->owned_triangles()[k]);
+  for (size_t k = 0; k < nt; ++k) {
+    const auto& n = at.triangles[k];
+    names.insert(names.end(), {0, owned_.triangles[k].name[0], owned_.triangles[k].name[1], owned_.triangles[k].name[2]});
     points.push_back((x[n[0]] + x[n[1]] + x[n[2]]) / 3.0);
   }
-  for (size_t k = 0; k < owned.edges.size(); ++k) {
-    const auto& n = owned.edges[k];
-    ids.push_back(nt + patch_->owned_edges()[k]);
+  for (size_t k = 0; k < ne; ++k) {
+    const auto& n = at.edges[k];
+    names.insert(names.end(), {1, owned_.edges[k][0], owned_.edges[k][1], 0});
     points.push_back(0.5 * (x[n[0]] + x[n[1]]));
   }
-  for (const Index q : ids) weights.insert(weights.end(), {1.0f, 0.01f + weight_[q]});
-  return partition_->partition(ids, points, weights, static_cast<Index>(weight_.size()));
+  for (const float w : weight_) weights.insert(weights.end(), {1.0f, 0.01f + w});
+  const std::vector<int> to = partition_->partition(names, points, weights);
+  // The primitives that leave go to their new ranks with their data (a triangle: kind, name,
+  // nodes, body; an edge: kind, nodes).
+  const int me = dec_->rank();
+  NamedSurface kept;
+  std::vector<std::vector<Index>> out(dec_->size());
+  for (size_t k = 0; k < nt; ++k) {
+    const NamedTriangle& t = owned_.triangles[k];
+    if (to[k] == me) kept.triangles.push_back(t);
+    else
+      out[to[k]].insert(out[to[k]].end(), {0, t.name[0], t.name[1], t.name[2], t.nodes[0], t.nodes[1], t.nodes[2], t.body});
+  }
+  for (size_t k = 0; k < ne; ++k) {
+    if (to[nt + k] == me) kept.edges.push_back(owned_.edges[k]);
+    else out[to[nt + k]].insert(out[to[nt + k]].end(), {1, owned_.edges[k][0], owned_.edges[k][1]});
+  }
+  for (const auto& list : dec_->alltoall(out))
+    for (size_t i = 0; i < list.size();)
+      if (list[i] == 0) {
+        kept.triangles.push_back({{list[i + 1], list[i + 2], list[i + 3]}, {list[i + 4], list[i + 5], list[i + 6]},
+                                  static_cast<int>(list[i + 7])});
+        i += 8;
+      } else {
+        kept.edges.push_back({list[i + 1], list[i + 2]});
+        i += 3;
+      }
+  std::sort(kept.triangles.begin(), kept.triangles.end(),
+            [](const NamedTriangle& a, const NamedTriangle& b) { return a.name < b.name; });
+  std::sort(kept.edges.begin(), kept.edges.end());
+  const long before = static_cast<long>(nt + ne), after = static_cast<long>(kept.triangles.size() + kept.edges.size());
+  const std::vector<long> sums = dec_->sum(std::vector<long>{before, after});
+  SHATTER_REQUIRE(sums[0] == sums[1], "ContactStage: " << sums[0] << " primitives before RCB, " << sums[1] << " after");
+  own(std::move(kept));
+}
+
+void ContactStage::own(NamedSurface primitives) {
+  owned_ = std::move(primitives);
+  weight_.assign(owned_.triangles.size() + owned_.edges.size(), 0.0f);
+  patch_->own(owned_);
 }
 
 std::vector<std::int32_t> ContactStage::patch_rigid_bodies(const DcrRigidBodies& rigid) const {

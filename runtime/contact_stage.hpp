@@ -36,6 +36,7 @@
 #include "contact/surface.hpp"
 #include "runtime/contact_patch.hpp"
 #include "runtime/model.hpp"
+#include "runtime/named_surface.hpp"
 
 namespace shatter {
 
@@ -164,13 +165,15 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine` (patch ids), in
   /// whole ids, named in unresolved_ (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine);
-  /// The primitives owned here before the first partition (numbered as in ContactPatch::own):
-  /// on a part, those it names (owned_surface: a triangle by its element's owner, an edge by
-  /// its smallest-named triangle's); on a whole model, each by the volume owner of its first node.
-  std::vector<Index> first_owned() const;
-  /// The primitives owned here after an RCB partition of the owned ones at the patch's
-  /// x(n+1), weighted by their candidates.
-  std::vector<Index> partition();
+  /// The primitives owned here before the first partition: on a part, those it names
+  /// (owned_surface: a triangle by its element's owner, an edge by its smallest-named
+  /// triangle's); on a whole model, each by the volume owner of its first node.
+  NamedSurface first_owned() const;
+  /// A new RCB partition of the owned primitives at the patch's x(n+1), weighted by their
+  /// candidates; the primitives that leave go to their new ranks with their data (collective).
+  void partition();
+  /// The primitives owned here become `primitives` (owned_, the patch's, the weights).
+  void own(NamedSurface primitives);
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
@@ -206,7 +209,8 @@ class ContactStage {
   std::unique_ptr<ContactPartition> partition_;
   std::unique_ptr<ContactPatch> patch_;  ///< of surface_
   std::unique_ptr<PatchRanks> ranks_;    ///< DCR's exchanges between the patches
-  std::vector<float> weight_;            ///< per triangle, then edge: candidates at the last search (owned ones)
+  NamedSurface owned_;                   ///< the primitives owned here
+  std::vector<float> weight_;            ///< per owned primitive (triangles, then edges): candidates at the last search
   bool repartition_ = true;              ///< partition at the next search
 };
 
