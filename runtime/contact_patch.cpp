@@ -46,14 +46,15 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
   return boxes;
 }
 
-ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-                           const SurfaceVertices& vertices, const Model& model, Index num_nodes,
-                           std::span<const double> node_reach)
-    : dec_(dec), surface_(surface), around_(around), vertices_(vertices), model_(model), num_nodes_(num_nodes),
-      part_reach_(node_reach) {
-  SHATTER_REQUIRE(vertices.whole.size() == surface.vertices.size(),
-                  "ContactPatch: " << vertices.whole.size() << " nodes for " << surface.vertices.size() << " vertices");
-  for (Index k = 0; k < surface.num_vertices(); ++k) {
+ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
+                           const Model& model, Index num_nodes, std::span<const double> node_reach)
+    : dec_(dec), vertices_(vertices), model_(model), num_nodes_(num_nodes), part_reach_(node_reach),
+      home_(std::move(home)) {
+  for (size_t t = 0; t < home_.size(); ++t)
+    for (const Index n : home_[t].nodes) home_at_.emplace_back(n, static_cast<Index>(t));
+  std::sort(home_at_.begin(), home_at_.end());
+  const auto nv = static_cast<Index>(vertices.whole.size());
+  for (Index k = 0; k < nv; ++k) {
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
     const Index n = vertices.node[k];
@@ -68,7 +69,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
     if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
-  position_.assign(surface.num_vertices(), -1);
+  position_.assign(nv, -1);
   renumber(kept_);
 }
 
@@ -211,7 +212,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
   // ~7 times, took a third of reach()'s CPU time on the 76 cubes), then those of the
   // triangles around them, whose normals orient their pairs (activate()).
-  node_mark_.resize(surface_.vertices.size(), 0);
+  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed;
   for (const auto& t : owned_.triangles)
     for (const Index n : t) add_node(nodes_[n], needed);
@@ -220,11 +221,10 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (const Index n : vertices) add_node(n, needed);
   std::vector<Index> nodes = needed;
   for (const Index n : kept_) add_node(n, nodes);
-  for (size_t k = 0, count = needed.size(); k < count; ++k) {
-    const Index p = around_.position[needed[k]];
-    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i)
-      for (const Index n : surface_.triangles[around_.items[i]]) add_node(n, nodes);
-  }
+  fetch_rings(needed);
+  for (size_t k = 0, count = needed.size(); k < count; ++k)
+    for (const Index t : ring_of_.at(needed[k]))
+      for (const Index whole : ring_[t].nodes) add_node(vertex(whole), nodes);
   for (const Index n : nodes) node_mark_[n] = 0;
   std::sort(needed.begin(), needed.end());
   std::sort(nodes.begin(), nodes.end());
@@ -268,42 +268,95 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (marks kept between searches, cleared after use); surface vertex ids.
-  triangle_mark_.resize(surface_.triangles.size(), 0);
-  node_mark_.resize(surface_.vertices.size(), 0);
+  // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'); surface
+  // vertex ids.
+  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed, triangles;
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) add_node(nodes_[k], needed);
   for (size_t k = 0, count = needed.size(); k < count; ++k) {
-    const Index p = around_.position[needed[k]];
-    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i) {
-      const Index t = around_.items[i];
-      if (!triangle_mark_[t]) triangle_mark_[t] = 1, triangles.push_back(t);
-    }
+    const std::vector<Index>& ring = ring_of_.at(needed[k]);
+    triangles.insert(triangles.end(), ring.begin(), ring.end());
   }
-  for (const Index t : triangles) {
-    triangle_mark_[t] = 0;
-    for (const Index n : surface_.triangles[t]) add_node(n, needed);
-  }
+  sort_unique(triangles);
+  std::sort(triangles.begin(), triangles.end(), [&](Index a, Index b) { return ring_[a].name < ring_[b].name; });
+  for (const Index t : triangles)
+    for (const Index whole : ring_[t].nodes) add_node(vertex(whole), needed);
   sort_marked(needed);
-  std::sort(triangles.begin(), triangles.end());
-  // reach() holds the triangles around the patch's nodes in the patch. Only the triangles,
-  // their vertices and the vertex -> triangle lists are made (surface_normal's needs).
+  // reach() holds the rings' nodes in the patch. Only the triangles, their vertices and the
+  // vertex -> triangle lists are made (surface_normal's needs).
   normals_ = {};
-  std::vector<char> vertex(nodes_.size(), 0);
+  std::vector<char> vertex_mark(nodes_.size(), 0);
   for (const Index t : triangles) {
-    const auto& [a, b, c] = surface_.triangles[t];
-    normals_.triangles.push_back({position_[a], position_[b], position_[c]});
-    normals_.body.push_back(surface_.body[t]);
-    for (const Index n : normals_.triangles.back()) vertex[n] = 1;
+    const auto& [a, b, c] = ring_[t].nodes;
+    normals_.triangles.push_back({position_[vertex(a)], position_[vertex(b)], position_[vertex(c)]});
+    normals_.body.push_back(ring_[t].body);
+    for (const Index n : normals_.triangles.back()) vertex_mark[n] = 1;
   }
-  for (size_t k = 0; k < vertex.size(); ++k)
-    if (vertex[k]) normals_.vertices.push_back(static_cast<Index>(k));
+  for (size_t k = 0; k < vertex_mark.size(); ++k)
+    if (vertex_mark[k]) normals_.vertices.push_back(static_cast<Index>(k));
   normals_around_ = vertex_triangles(normals_);
   auto& lists = lists_[static_cast<int>(PatchPlan::Active)];
   lists = plan(needed, true);
   plans_[static_cast<int>(PatchPlan::Active)] = halo_of(lists);
   active_fresh_ = true;
+}
+
+Index ContactPatch::ring_triangle(const NamedTriangle& t) {
+  const auto [it, fresh] = ring_name_.try_emplace(t.name, static_cast<Index>(ring_.size()));
+  if (fresh) ring_.push_back(t);
+  return it->second;
+}
+
+void ContactPatch::fetch_rings(std::span<const Index> vertices) {
+  // Each vertex's volume owner holds every triangle around it (home_triangles). Asked for a
+  // list of vertices, it answers with the triangles around them, each once (kind-free: 7
+  // numbers, name, nodes, body), in name order.
+  const int ranks = dec_.size(), me = dec_.rank();
+  std::vector<std::vector<Index>> ask(ranks);
+  std::vector<Index> mine;
+  for (const Index v : vertices)
+    if (!ring_of_.contains(v)) {
+      if (vertices_.owner[v] == me) mine.push_back(v);
+      else ask[vertices_.owner[v]].push_back(vertices_.whole[v]);
+    }
+  for (std::vector<Index>& list : ask) std::sort(list.begin(), list.end());
+  const auto around_home = [&](Index whole, std::vector<Index>& out) {
+    const auto first = std::lower_bound(home_at_.begin(), home_at_.end(), std::pair<Index, Index>(whole, -1));
+    for (auto it = first; it != home_at_.end() && it->first == whole; ++it) out.push_back(it->second);
+  };
+  const std::vector<std::vector<Index>> asked = dec_.alltoall(ask);
+  std::vector<std::vector<Index>> reply(ranks);
+  for (int r = 0; r < ranks; ++r) {
+    std::vector<Index> triangles;
+    for (const Index whole : asked[r]) around_home(whole, triangles);
+    sort_unique(triangles);
+    for (const Index t : triangles) {
+      const NamedTriangle& tri = home_[t];
+      reply[r].insert(reply[r].end(), tri.name.begin(), tri.name.end());
+      reply[r].insert(reply[r].end(), tri.nodes.begin(), tri.nodes.end());
+      reply[r].push_back(tri.body);
+    }
+  }
+  const std::vector<std::vector<Index>> answers = dec_.alltoall(reply);
+  for (const Index v : mine) {
+    std::vector<Index> triangles;
+    around_home(vertices_.whole[v], triangles);
+    std::vector<Index>& ring = ring_of_[v];
+    for (const Index t : triangles) ring.push_back(ring_triangle(home_[t]));
+  }
+  // An asked vertex's ring: the answered triangles that hold it (its owner sent them all).
+  for (int r = 0; r < ranks; ++r) {
+    for (const Index whole : ask[r]) ring_of_[vertex(whole)];
+    const std::vector<Index>& list = answers[r];
+    for (size_t i = 0; i + 7 <= list.size(); i += 7) {
+      const NamedTriangle t{{list[i], list[i + 1], list[i + 2]}, {list[i + 3], list[i + 4], list[i + 5]},
+                            static_cast<int>(list[i + 6])};
+      const Index at = ring_triangle(t);
+      for (const Index whole : t.nodes)
+        if (std::binary_search(ask[r].begin(), ask[r].end(), whole)) ring_of_[vertex(whole)].push_back(at);
+    }
+  }
 }
 
 ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {

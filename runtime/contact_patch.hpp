@@ -56,15 +56,14 @@ enum class PatchPlan { Owned, Patch, Active };
 
 class ContactPatch {
  public:
-  /// surface, around: the contact surface in surface vertex ids (vertex k is the surface's
-  /// k-th node: vertices = 0, 1, ...) and its vertex -> triangle lists; vertices: what is
-  /// known of each surface vertex; all three held by the caller for the patch's lifetime (a
-  /// new surface needs a new patch). model: the part (its nodes' whole ids, its bodies);
-  /// num_nodes: the length of the part's nodal arrays; node_reach: per part node, its reach
-  /// (inflated_boxes; empty without shells), held by the caller.
-  ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               const SurfaceVertices& vertices, const Model& model, Index num_nodes,
-               std::span<const double> node_reach = {});
+  /// vertices: what is known of each vertex of the contact surface (vertex k: the surface's
+  /// k-th node, ascending in whole id), held by the caller for the patch's lifetime (a new
+  /// surface needs a new patch); home: the surface's triangles around the vertices whose
+  /// volume owner this rank is (home_triangles), in name order. model: the part (its nodes'
+  /// whole ids, its bodies); num_nodes: the length of the part's nodal arrays; node_reach:
+  /// per part node, its reach (inflated_boxes; empty without shells), held by the caller.
+  ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
+               const Model& model, Index num_nodes, std::span<const double> node_reach = {});
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
@@ -101,8 +100,8 @@ class ContactPatch {
   /// OwnedPairs), -1 for a ghost edge.
   Index owned_primitive(Index patch_primitive) const;
   /// The triangles whose normals the active pairs read (those around their nodes), in
-  /// surface order, and their vertices (no edges), with their vertex -> triangle lists
-  /// (patch node ids).
+  /// name order (the one-rank surface's), and their vertices (no edges), with their vertex ->
+  /// triangle lists (patch node ids).
   const ContactSurface& normals() const { return normals_; }
   const VertexTriangles& normals_around() const { return normals_around_; }
   /// The surface vertices whose volume owner this rank is, ascending (part node ids).
@@ -124,8 +123,6 @@ class ContactPatch {
   Index whole(Index k) const { return vertices_.whole[nodes_[k]]; }
   /// The rank that owns patch node k (its volume owner).
   int owner(Index k) const { return vertices_.owner[nodes_[k]]; }
-  /// The volume owner of surface vertex v.
-  int vertex_owner(Index v) const { return vertices_.owner[v]; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
@@ -182,10 +179,13 @@ class ContactPatch {
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
+  /// The rings (the triangles around them) of the listed surface vertices that have none yet,
+  /// from their volume owners (collective).
+  void fetch_rings(std::span<const Index> vertices);
+  /// The index in ring_ of triangle t, added if new.
+  Index ring_triangle(const NamedTriangle& t);
 
   const Decomposition& dec_;
-  const ContactSurface& surface_;
-  const VertexTriangles& around_;
   const SurfaceVertices& vertices_;
   const Model& model_;
   Index num_nodes_;
@@ -200,7 +200,14 @@ class ContactPatch {
   std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
   ContactSurface normals_;
   VertexTriangles normals_around_;
-  std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach() and activate(), 0 between calls
+  std::vector<std::uint8_t> node_mark_;  ///< scratch of reach() and activate(), 0 between calls
+  // The rings (docs/parallel.md "Patches with their own topology", step 2): the triangles
+  // around the patch's vertices, which orient its pairs, from the vertices' volume owners.
+  std::vector<NamedTriangle> home_;           ///< around the vertices whose volume owner this rank is
+  std::vector<std::pair<Index, Index>> home_at_;  ///< (whole node, home_ index), ascending
+  std::vector<NamedTriangle> ring_;           ///< every triangle fetched, once
+  std::map<std::array<Index, 3>, Index> ring_name_;  ///< ring_'s index of a triangle's name
+  std::map<Index, std::vector<Index>> ring_of_;      ///< per surface vertex fetched: its triangles (ring_ indices, name order)
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet

@@ -106,10 +106,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
     return;
   }
   set_vertices(mesh);
-  vertex_triangles_ = vertex_triangles(surface_);
+  vertex_triangles_ = {};
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, vertices_, model_, mesh.num_nodes(),
-                                          reach_);
+  patch_ = std::make_unique<ContactPatch>(*dec_, vertices_, home_triangles(), model_, mesh.num_nodes(), reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, *dec_);
   repartition_ = true;
 }
@@ -243,12 +242,26 @@ NamedSurface ContactStage::first_owned() const {
   const std::vector<Index>& whole = vertices_.whole;
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
     const auto& n = surface_.triangles[t];
-    if (patch_->vertex_owner(n[0]) == dec_->rank())
+    if (vertices_.owner[n[0]] == dec_->rank())
       owned.triangles.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
   }
   for (const auto& [a, b] : surface_.edges)
-    if (patch_->vertex_owner(a) == dec_->rank()) owned.edges.push_back({whole[a], whole[b]});
+    if (vertices_.owner[a] == dec_->rank()) owned.edges.push_back({whole[a], whole[b]});
   return owned;
+}
+
+std::vector<NamedTriangle> ContactStage::home_triangles() const {
+  if (model_.is_part()) return shatter::home_triangles(model_, *dec_);
+  // A whole model on ranks: named as in first_owned().
+  std::vector<NamedTriangle> home;
+  const std::vector<Index>& whole = vertices_.whole;
+  for (Index t = 0; t < surface_.num_triangles(); ++t) {
+    const auto& n = surface_.triangles[t];
+    const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
+    if (mine(n[0]) || mine(n[1]) || mine(n[2]))
+      home.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
+  }
+  return home;
 }
 
 void ContactStage::partition() {

@@ -169,6 +169,9 @@ class ContactStage {
   /// (owned_surface: a triangle by its element's owner, an edge by its smallest-named
   /// triangle's); on a whole model, each by the volume owner of its first node.
   NamedSurface first_owned() const;
+  /// The surface's triangles around the vertices whose volume owner this rank is, named as in
+  /// first_owned(): on a part from its mesh (home_triangles), on a whole model from the surface.
+  std::vector<NamedTriangle> home_triangles() const;
   /// A new RCB partition of the owned primitives at the patch's x(n+1), weighted by their
   /// candidates; the primitives that leave go to their new ranks with their data (collective).
   void partition();

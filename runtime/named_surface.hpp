@@ -43,4 +43,12 @@ struct NamedSurface {
 /// or a whole model), but the faces in `skip` (local (element, face), ascending).
 NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::span<const MeshFace> skip = {});
 
+/// The boundary triangles through the nodes whose volume owner this rank is
+/// (Decomposition::node_owner), in name order: around each such node, every triangle of the
+/// whole surface, those whose normals the surface normal there sums (surface_normal). The
+/// owner holds the node's star, so it classifies the faces through the node as the whole
+/// mesh does.
+std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec,
+                                          std::span<const MeshFace> skip = {});
+
 }  // namespace shatter

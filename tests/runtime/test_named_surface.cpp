@@ -2,7 +2,9 @@
 // and 3 ranks: each rank names the boundary triangles of its owned elements and the
 // edges whose smallest-named triangle is one of them; over the ranks the triangles in
 // name order are the one-rank surface's, triangle for triangle, and every edge of the
-// whole surface is listed once. TET4 and TET10 (whose faces are 4 sub-triangles each).
+// whole surface is listed once; and the triangles a rank lists around the nodes whose
+// volume owner it is are the whole surface's there. TET4 and TET10 (whose faces are 4
+// sub-triangles each).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,6 +82,25 @@ void check_order(int order) {
     EXPECT_LT(mine.triangles.size(), surface.triangles.size());
     EXPECT_LT(mine.edges.size(), surface.edges.size());
   }
+
+  // Around each surface node whose volume owner this rank is, its home triangles are the
+  // whole surface's (names, nodes, bodies), in name order.
+  const std::vector<NamedTriangle> home = home_triangles(part, dec);
+  const VertexTriangles around = vertex_triangles(surface);
+  long checked = 0;
+  for (Index k = 0; k < surface.num_vertices(); ++k) {
+    const Index whole_id = surface.vertices[k], n = part.local_node(whole_id);
+    if (n < 0 || (ranks > 1 && (dec.node_ranks(n).empty() || dec.node_owner(n) != rank))) continue;
+    std::vector<NamedTriangle> expected, got;
+    for (Index i = around.offsets[k]; i < around.offsets[k + 1]; ++i) expected.push_back(all[around.items[i]]);
+    for (const NamedTriangle& t : home)
+      if (std::find(t.nodes.begin(), t.nodes.end(), whole_id) != t.nodes.end()) got.push_back(t);
+    EXPECT_EQ(got, expected) << "triangles around node " << whole_id;
+    ++checked;
+  }
+  long counts[2] = {checked, static_cast<long>(surface.vertices.size())};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(counts[0], counts[1]) << "surface nodes with no volume owner, or with two";
 }
 
 TEST(NamedSurface, RanksNameTheWholeSurfaceOnceTet4) { check_order(1); }
