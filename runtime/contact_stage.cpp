@@ -39,8 +39,9 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
     shell_body_[shell.body] = 1;
     for (Index v = 0; v < shell.mesh.num_vertices(); ++v) reach_[shell.first_node + v] = 0.5 * shell.thickness;
   }
-  // A part of the model brings the whole model's surface, in surface vertex ids.
-  if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
+  // A part holds no triangles of the surface but its own elements' (named_surface.hpp): its
+  // patch names them and gets the rest from the other ranks.
+  if (model.is_part()) set_surface({}, model.mesh);
   else rebuild(model.mesh);
 }
 

@@ -117,9 +117,14 @@ class ContactStage {
   void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {},
                std::span<const std::array<Index, 2>> twins = {});
 
-  /// The contact surface: in the mesh's node ids on one rank; on several, in surface vertex
-  /// ids (vertex k is the surface's k-th node, surface_nodes()[k] here).
+  /// The contact surface: in the mesh's node ids on one rank; on several holding the whole
+  /// model, in surface vertex ids (vertex k is the surface's k-th node, surface_nodes()[k]
+  /// here); on a part, empty (each rank's patch holds its share).
   const ContactSurface& surface() const { return surface_; }
+  /// The number of triangles of the whole contact surface.
+  Index surface_triangles() const {
+    return model_.is_part() ? model_.part.surface_triangles : surface_.num_triangles();
+  }
   /// The surface's nodes, ascending (mesh node ids; on several ranks, -1 for a node the
   /// part does not hold).
   std::span<const Index> surface_nodes() const { return dec_ ? vertices_.node : surface_.vertices; }
