@@ -88,6 +88,10 @@ Index ContactPatch::node(Index whole) const {
   return k;
 }
 
+long ContactPatch::whole_surface_bytes() const {
+  return static_cast<long>(position_.capacity() * sizeof(Index) + node_mark_.capacity());
+}
+
 Index ContactPatch::owned_primitive(Index q) const {
   const Index nt = owned_.num_triangles();
   if (q < nt) return q;

@@ -127,6 +127,8 @@ class ContactPatch {
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
   std::span<Vec3> v() { return v_; }
+  /// The bytes of its arrays sized by the whole surface (per surface vertex).
+  long whole_surface_bytes() const;
   /// Per patch node: its reach (empty without shells).
   std::span<const double> node_reach() const { return reach_; }
   /// Per patch node: its inverse mass and held components (as a number: bit k = component

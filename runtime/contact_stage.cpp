@@ -339,17 +339,25 @@ ContactBalance ContactStage::balance() const {
   const ContactProfile& p = profile_;
   ContactBalance b{p.owned_pairs,     p.owned_pairs, p.owned_pairs,        p.candidates,
                    p.states_posted,   p.state_bytes, p.found_bytes,        p.search_cpu_seconds,
-                   p.sweep_cpu_seconds};
+                   p.sweep_cpu_seconds, whole_surface_bytes()};
   if (dec_) {
-    long most[4] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max},
+    long most[5] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max, b.whole_surface_bytes_max},
          sum[3] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum};
     double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
-    MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_LONG, MPI_MAX, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_LONG, MPI_MAX, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_LONG, MPI_SUM, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
-    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1]};
+    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4]};
   }
   return b;
+}
+
+long ContactStage::whole_surface_bytes() const {
+  auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
+  return b(surface_.triangles) + b(surface_.body) + b(surface_.edges) + b(surface_.vertices) +
+         b(vertex_triangles_.offsets) + b(vertex_triangles_.items) + b(vertex_triangles_.position) +
+         b(vertices_.whole) + b(vertices_.node) + b(vertices_.owner) + b(vertices_.body) + b(body_) + b(twin_of_) +
+         (patch_ ? patch_->whole_surface_bytes() : 0);
 }
 
 std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine) {

@@ -79,6 +79,7 @@ struct ContactBalance {
   long states_posted_sum = 0;  ///< ContactProfile::states_posted
   long state_bytes_max = 0, found_bytes_max = 0;
   double search_cpu_max = 0, sweep_cpu_max = 0;
+  long whole_surface_bytes_max = 0;  ///< ContactStage::whole_surface_bytes
 };
 
 class Decomposition;
@@ -144,6 +145,10 @@ class ContactStage {
   const ContactProfile& profile() const { return profile_; }
   /// profile() over the ranks (collective).
   ContactBalance balance() const;
+  /// The bytes of the contact arrays this rank holds that are sized by the whole contact
+  /// surface (its topology, per-vertex tables and scratch; the part's own per-vertex tables
+  /// are model bytes): on a part, the term that still grows with the whole model.
+  long whole_surface_bytes() const;
   /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
   /// median surface edge length.
   double margin() const { return margin_; }
