@@ -54,6 +54,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vert
     for (const Index n : home_[t].nodes) home_at_.emplace_back(n, static_cast<Index>(t));
   std::sort(home_at_.begin(), home_at_.end());
   const auto nv = static_cast<Index>(vertices.whole.size());
+  ring_at_.assign(nv, -1);
   for (Index k = 0; k < nv; ++k) {
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
@@ -89,7 +90,7 @@ Index ContactPatch::node(Index whole) const {
 }
 
 long ContactPatch::whole_surface_bytes() const {
-  return static_cast<long>(position_.capacity() * sizeof(Index) + node_mark_.capacity());
+  return static_cast<long>((position_.capacity() + ring_at_.capacity()) * sizeof(Index) + node_mark_.capacity());
 }
 
 Index ContactPatch::owned_primitive(Index q) const {
@@ -227,8 +228,8 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (const Index n : kept_) add_node(n, nodes);
   fetch_rings(needed);
   for (size_t k = 0, count = needed.size(); k < count; ++k)
-    for (const Index t : ring_of_.at(needed[k]))
-      for (const Index whole : ring_[t].nodes) add_node(vertex(whole), nodes);
+    for (const Index t : ring_of(needed[k]))
+      for (const Index n : ring_.triangles[t]) add_node(n, nodes);
   for (const Index n : nodes) node_mark_[n] = 0;
   std::sort(needed.begin(), needed.end());
   std::sort(nodes.begin(), nodes.end());
@@ -279,22 +280,22 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) add_node(nodes_[k], needed);
   for (size_t k = 0, count = needed.size(); k < count; ++k) {
-    const std::vector<Index>& ring = ring_of_.at(needed[k]);
+    const std::span<const Index> ring = ring_of(needed[k]);
     triangles.insert(triangles.end(), ring.begin(), ring.end());
   }
   sort_unique(triangles);
-  std::sort(triangles.begin(), triangles.end(), [&](Index a, Index b) { return ring_[a].name < ring_[b].name; });
+  std::sort(triangles.begin(), triangles.end(), [&](Index a, Index b) { return ring_names_[a] < ring_names_[b]; });
   for (const Index t : triangles)
-    for (const Index whole : ring_[t].nodes) add_node(vertex(whole), needed);
+    for (const Index n : ring_.triangles[t]) add_node(n, needed);
   sort_marked(needed);
   // reach() holds the rings' nodes in the patch. Only the triangles, their vertices and the
   // vertex -> triangle lists are made (surface_normal's needs).
   normals_ = {};
   std::vector<char> vertex_mark(nodes_.size(), 0);
   for (const Index t : triangles) {
-    const auto& [a, b, c] = ring_[t].nodes;
-    normals_.triangles.push_back({position_[vertex(a)], position_[vertex(b)], position_[vertex(c)]});
-    normals_.body.push_back(ring_[t].body);
+    const auto& [a, b, c] = ring_.triangles[t];
+    normals_.triangles.push_back({position_[a], position_[b], position_[c]});
+    normals_.body.push_back(ring_.body[t]);
     for (const Index n : normals_.triangles.back()) vertex_mark[n] = 1;
   }
   for (size_t k = 0; k < vertex_mark.size(); ++k)
@@ -307,9 +308,19 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
 }
 
 Index ContactPatch::ring_triangle(const NamedTriangle& t) {
-  const auto [it, fresh] = ring_name_.try_emplace(t.name, static_cast<Index>(ring_.size()));
-  if (fresh) ring_.push_back(t);
+  const auto [it, fresh] = ring_name_.try_emplace(t.name, ring_.num_triangles());
+  if (fresh) {
+    ring_.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    ring_.body.push_back(t.body);
+    ring_names_.push_back(t.name);
+  }
   return it->second;
+}
+
+std::span<const Index> ContactPatch::ring_of(Index v) const {
+  SHATTER_ASSERT(ring_at_[v] >= 0);
+  const Index k = ring_at_[v];
+  return {ring_items_.data() + ring_offsets_[k], static_cast<size_t>(ring_offsets_[k + 1] - ring_offsets_[k])};
 }
 
 void ContactPatch::fetch_rings(std::span<const Index> vertices) {
@@ -320,7 +331,7 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   std::vector<std::vector<Index>> ask(ranks);
   std::vector<Index> mine;
   for (const Index v : vertices)
-    if (!ring_of_.contains(v)) {
+    if (ring_at_[v] < 0) {
       if (vertices_.owner[v] == me) mine.push_back(v);
       else ask[vertices_.owner[v]].push_back(vertices_.whole[v]);
     }
@@ -343,23 +354,32 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
     }
   }
   const std::vector<std::vector<Index>> answers = dec_.alltoall(reply);
+  // Each ring is appended whole to ring_items_ (one array: the rings are read together at
+  // every search).
+  const auto append = [&](Index v, const std::vector<Index>& ring) {
+    ring_at_[v] = static_cast<Index>(ring_offsets_.size() - 1);
+    ring_items_.insert(ring_items_.end(), ring.begin(), ring.end());
+    ring_offsets_.push_back(static_cast<Index>(ring_items_.size()));
+  };
   for (const Index v : mine) {
-    std::vector<Index> triangles;
+    std::vector<Index> triangles, ring;
     around_home(vertices_.whole[v], triangles);
-    std::vector<Index>& ring = ring_of_[v];
     for (const Index t : triangles) ring.push_back(ring_triangle(home_[t]));
+    append(v, ring);
   }
   // An asked vertex's ring: the answered triangles that hold it (its owner sent them all).
   for (int r = 0; r < ranks; ++r) {
-    for (const Index whole : ask[r]) ring_of_[vertex(whole)];
+    std::vector<std::vector<Index>> rings(ask[r].size());
     const std::vector<Index>& list = answers[r];
     for (size_t i = 0; i + 7 <= list.size(); i += 7) {
       const NamedTriangle t{{list[i], list[i + 1], list[i + 2]}, {list[i + 3], list[i + 4], list[i + 5]},
                             static_cast<int>(list[i + 6])};
       const Index at = ring_triangle(t);
       for (const Index whole : t.nodes)
-        if (std::binary_search(ask[r].begin(), ask[r].end(), whole)) ring_of_[vertex(whole)].push_back(at);
+        if (const auto it = std::lower_bound(ask[r].begin(), ask[r].end(), whole); it != ask[r].end() && *it == whole)
+          rings[it - ask[r].begin()].push_back(at);
     }
+    for (size_t k = 0; k < ask[r].size(); ++k) append(vertex(ask[r][k]), rings[k]);
   }
 }
 

@@ -186,6 +186,8 @@ class ContactPatch {
   void fetch_rings(std::span<const Index> vertices);
   /// The index in ring_ of triangle t, added if new.
   Index ring_triangle(const NamedTriangle& t);
+  /// The ring of surface vertex v (fetched).
+  std::span<const Index> ring_of(Index v) const;
 
   const Decomposition& dec_;
   const SurfaceVertices& vertices_;
@@ -207,9 +209,11 @@ class ContactPatch {
   // around the patch's vertices, which orient its pairs, from the vertices' volume owners.
   std::vector<NamedTriangle> home_;           ///< around the vertices whose volume owner this rank is
   std::vector<std::pair<Index, Index>> home_at_;  ///< (whole node, home_ index), ascending
-  std::vector<NamedTriangle> ring_;           ///< every triangle fetched, once
+  ContactSurface ring_;                       ///< every triangle fetched, once (triangles and bodies; surface vertex ids)
+  std::vector<std::array<Index, 3>> ring_names_;     ///< per triangle of ring_: its name
   std::map<std::array<Index, 3>, Index> ring_name_;  ///< ring_'s index of a triangle's name
-  std::map<Index, std::vector<Index>> ring_of_;      ///< per surface vertex fetched: its triangles (ring_ indices, name order)
+  std::vector<Index> ring_at_;  ///< per surface vertex: its ring (k: ring_offsets_[k]), -1 before it is fetched
+  std::vector<Index> ring_offsets_{0}, ring_items_;  ///< the rings fetched, CSR: ring_ indices, name order
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
