@@ -17,25 +17,6 @@ namespace {
 constexpr std::array<std::array<int, 3>, 4> kOutwardFaces = {
     {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
 
-/// Local TET10 node on the edge between corners i and j.
-int tet10_mid_node(int i, int j) {
-  for (int e = 0; e < 6; ++e) {
-    const auto [a, b] = kTet10Edges[e];
-    if ((a == i && b == j) || (a == j && b == i)) return 4 + e;
-  }
-  SHATTER_ASSERT(false);
-  return -1;
-}
-
-/// Local node triples of the sub-triangles of each outward face:
-/// TET4 one per face, TET10 four per face (corners a,b,c; mids ab, bc, ca).
-std::vector<std::array<int, 3>> face_triangles(int order, int face) {
-  const auto [a, b, c] = kOutwardFaces[face];
-  if (order == 1) return {{a, b, c}};
-  const int ab = tet10_mid_node(a, b), bc = tet10_mid_node(b, c), ca = tet10_mid_node(c, a);
-  return {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
-}
-
 /// Sorted unique edges {lo, hi} and vertices of a range of triangles.
 void triangle_edges_and_vertices(std::span<const SurfaceTriangle> triangles,
                                  std::vector<std::array<Index, 2>>& edges,
@@ -65,14 +46,50 @@ void merge_unique(std::vector<T>& into, const std::vector<T>& more) {
   into.swap(merged);
 }
 
+/// Local TET10 node on the edge between corners i and j.
+int tet10_mid_node(int i, int j) {
+  for (int e = 0; e < 6; ++e) {
+    const auto [a, b] = kTet10Edges[e];
+    if ((a == i && b == j) || (a == j && b == i)) return 4 + e;
+  }
+  SHATTER_ASSERT(false);
+  return -1;
+}
+
+/// Per order (1, 2) and outward face: the local node triples of its sub-triangles.
+std::array<std::array<std::vector<std::array<int, 3>>, 4>, 2> make_face_triangles() {
+  std::array<std::array<std::vector<std::array<int, 3>>, 4>, 2> table;
+  for (int f = 0; f < 4; ++f) {
+    const auto [a, b, c] = kOutwardFaces[f];
+    table[0][f] = {{a, b, c}};
+    const int ab = tet10_mid_node(a, b), bc = tet10_mid_node(b, c), ca = tet10_mid_node(c, a);
+    table[1][f] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
+  }
+  return table;
+}
+
 }  // namespace
+
+std::span<const std::array<int, 3>> face_triangles(int order, int face) {
+  static const auto table = make_face_triangles();
+  return table[order - 1][face];
+}
 
 ContactSurface build_contact_surface(const Mesh& mesh) { return build_contact_surface(mesh, {}); }
 
-ContactSurface build_contact_surface(const Mesh& mesh, std::span<const std::pair<Index, int>> skip) {
-  SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "build_contact_surface: mesh order "
-                                                          << mesh.order
-                                                          << " (expected 1 = TET4 or 2 = TET10)");
+ContactSurface build_contact_surface(const Mesh& mesh, std::span<const MeshFace> skip) {
+  std::vector<SurfaceTriangle> triangles;
+  for (const auto& [e, f] : boundary_faces(mesh, skip)) {
+    const Index* n = mesh.element(e);
+    for (const auto& t : face_triangles(mesh.order, f))
+      triangles.push_back({{n[t[0]], n[t[1]], n[t[2]]}, mesh.elem_body[e]});
+  }
+  return make_contact_surface(triangles);
+}
+
+std::vector<MeshFace> boundary_faces(const Mesh& mesh, std::span<const MeshFace> skip) {
+  SHATTER_REQUIRE(mesh.order == 1 || mesh.order == 2, "boundary_faces: mesh order "
+                                                          << mesh.order << " (expected 1 = TET4 or 2 = TET10)");
   // Every face as (sorted corner ids, element, local face); a face is on the
   // boundary when its sorted key occurs once.
   struct Face {
@@ -95,26 +112,16 @@ ContactSurface build_contact_surface(const Mesh& mesh, std::span<const std::pair
   std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
     return std::tie(a.key, a.elem, a.local) < std::tie(b.key, b.elem, b.local);
   });
-  std::vector<std::pair<Index, int>> boundary;  // (element, local face)
+  std::vector<MeshFace> boundary;
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
     while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-    if (j - i == 1 && !std::binary_search(skip.begin(), skip.end(), std::pair<Index, int>(faces[i].elem, faces[i].local)))
+    if (j - i == 1 && !std::binary_search(skip.begin(), skip.end(), MeshFace(faces[i].elem, faces[i].local)))
       boundary.emplace_back(faces[i].elem, faces[i].local);
     i = j;
   }
   std::sort(boundary.begin(), boundary.end());
-
-  std::array<std::vector<std::array<int, 3>>, 4> local_triangles;
-  for (int f = 0; f < 4; ++f) local_triangles[f] = face_triangles(mesh.order, f);
-  std::vector<SurfaceTriangle> triangles;
-  triangles.reserve(boundary.size() * local_triangles[0].size());
-  for (const auto& [e, f] : boundary) {
-    const Index* n = mesh.element(e);
-    for (const auto& t : local_triangles[f])
-      triangles.push_back({{n[t[0]], n[t[1]], n[t[2]]}, mesh.elem_body[e]});
-  }
-  return make_contact_surface(triangles);
+  return boundary;
 }
 
 ContactSurface make_contact_surface(std::span<const SurfaceTriangle> triangles) {

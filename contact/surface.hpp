@@ -49,14 +49,25 @@ struct SurfaceTriangle {
   int body;
 };
 
-/// Boundary of a tetrahedral mesh: the faces that belong to exactly one
-/// tetrahedron, oriented outward (mesh elements have positive volume in Gmsh
-/// node order, so the outward faces are (0,2,1), (0,1,3), (0,3,2), (1,2,3)).
-/// Triangles are listed by element, then local face (then sub-triangle for
-/// TET10). Cost O(E log E).
+/// A face of a mesh: (element, local face). Local face f is outward face f: mesh elements
+/// have positive volume in Gmsh node order, so the outward faces are (0,2,1), (0,1,3),
+/// (0,3,2), (1,2,3).
+using MeshFace = std::pair<Index, int>;
+
+/// The faces that belong to exactly one tetrahedron, but those in `skip` (ascending),
+/// ascending. Cost O(E log E).
+std::vector<MeshFace> boundary_faces(const Mesh& mesh, std::span<const MeshFace> skip = {});
+
+/// The local node triples of the triangles of outward face `face`, outward: one for TET4
+/// (order 1); for TET10 (order 2) its 4 sub-triangles (corner, mid, mid) x 3, then
+/// (mid, mid, mid).
+std::span<const std::array<int, 3>> face_triangles(int order, int face);
+
+/// Boundary of a tetrahedral mesh: the triangles of boundary_faces, listed by element, then
+/// local face, then sub-triangle (face_triangles).
 ContactSurface build_contact_surface(const Mesh& mesh);
 /// The same without the boundary faces in `skip`: (element, local face), ascending.
-ContactSurface build_contact_surface(const Mesh& mesh, std::span<const std::pair<Index, int>> skip);
+ContactSurface build_contact_surface(const Mesh& mesh, std::span<const MeshFace> skip);
 
 /// Append triangles (e.g. crack faces opened by fracture) and update the
 /// vertex and edge lists incrementally: O((t + k) log k + e + v) for k new

@@ -2,8 +2,6 @@
 
 #include <zoltan.h>
 
-#include <algorithm>
-
 #include "kernels/error.hpp"
 
 namespace shatter {
@@ -15,22 +13,23 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   SHATTER_REQUIRE(Zoltan_Initialize(0, nullptr, &version) == ZOLTAN_OK, "Zoltan_Initialize failed");
   zz_ = Zoltan_Create(comm);
   SHATTER_REQUIRE(zz_, "Zoltan_Create failed");
-  for (const auto& [key, value] : {std::pair{"DEBUG_LEVEL", "0"}, {"LB_METHOD", "RCB"}, {"NUM_GID_ENTRIES", "1"}, {"NUM_LID_ENTRIES", "1"},
-                                   {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "IMPORT AND EXPORT"},
+  for (const auto& [key, value] : {std::pair{"DEBUG_LEVEL", "0"}, {"LB_METHOD", "RCB"}, {"NUM_GID_ENTRIES", "4"}, {"NUM_LID_ENTRIES", "1"},
+                                   {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "EXPORT"},
                                    {"RCB_REUSE", "0"}, {"KEEP_CUTS", "0"}, {"IMBALANCE_TOL", "1.02"}})
     Zoltan_Set_Param(zz_, key, value);
   Zoltan_Set_Num_Obj_Fn(
       zz_, [](void* data, int* ierr) -> int {
         *ierr = ZOLTAN_OK;
-        return static_cast<int>(static_cast<ContactPartition*>(data)->ids_.size());
+        return static_cast<int>(static_cast<ContactPartition*>(data)->points_.size());
       },
       this);
   Zoltan_Set_Obj_List_Fn(
       zz_,
       [](void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int wdim, float* weights, int* ierr) {
         const auto* self = static_cast<ContactPartition*>(data);
-        for (size_t k = 0; k < self->ids_.size(); ++k) {
-          gids[k] = static_cast<ZOLTAN_ID_TYPE>(self->ids_[k]);
+        for (size_t k = 0; k < self->points_.size(); ++k) {
+          for (int w = 0; w < kNameWords; ++w)
+            gids[kNameWords * k + w] = static_cast<ZOLTAN_ID_TYPE>(self->names_[kNameWords * k + w]);
           lids[k] = static_cast<ZOLTAN_ID_TYPE>(k);
           for (int w = 0; w < wdim; ++w) weights[k * wdim + w] = self->weights_[2 * k + w];
         }
@@ -56,12 +55,12 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
 
 ContactPartition::~ContactPartition() { Zoltan_Destroy(&zz_); }
 
-std::vector<Index> ContactPartition::partition(std::span<const Index> ids, std::span<const Vec3> points,
-                                               std::span<const float> weights, Index total) {
-  SHATTER_REQUIRE(ids.size() == points.size() && 2 * points.size() == weights.size(),
-                  "ContactPartition: " << ids.size() << " ids, " << points.size() << " points, " << weights.size()
-                                       << " weights");
-  ids_ = ids;
+std::vector<int> ContactPartition::partition(std::span<const Index> names, std::span<const Vec3> points,
+                                             std::span<const float> weights) {
+  SHATTER_REQUIRE(names.size() == kNameWords * points.size() && 2 * points.size() == weights.size(),
+                  "ContactPartition: " << names.size() << " name words, " << points.size() << " points, "
+                                       << weights.size() << " weights");
+  names_ = names;
   points_ = points;
   weights_ = weights;
   int changes = 0, gid_entries = 0, lid_entries = 0, n_import = 0, n_export = 0;
@@ -70,28 +69,14 @@ std::vector<Index> ContactPartition::partition(std::span<const Index> ids, std::
   const int rc = Zoltan_LB_Partition(zz_, &changes, &gid_entries, &lid_entries, &n_import, &import_gids, &import_lids,
                                      &import_procs, &import_parts, &n_export, &export_gids, &export_lids,
                                      &export_procs, &export_parts);
-  // The objects kept here, and those that come here (Zoltan's migration lists).
-  std::vector<Index> owned;
-  if (rc == ZOLTAN_OK) {
-    std::vector<char> leaves(ids.size(), 0);
-    for (int k = 0; k < n_export; ++k)
-      if (export_parts[k] != rank_) leaves[export_lids[k]] = 1;
-    for (size_t k = 0; k < ids.size(); ++k)
-      if (!leaves[k]) owned.push_back(ids[k]);
-    for (int k = 0; k < n_import; ++k)
-      if (import_parts[k] == rank_) owned.push_back(static_cast<Index>(import_gids[k]));
-  }
+  std::vector<int> to(points.size(), rank_);
+  if (rc == ZOLTAN_OK)
+    for (int k = 0; k < n_export; ++k) to[export_lids[k]] = export_parts[k];
   Zoltan_LB_Free_Part(&import_gids, &import_lids, &import_procs, &import_parts);
   Zoltan_LB_Free_Part(&export_gids, &export_lids, &export_procs, &export_parts);
   // Every rank gets the same return code: Zoltan's calls are collective.
   SHATTER_REQUIRE(rc == ZOLTAN_OK, "Zoltan_LB_Partition (RCB) failed with code " << rc);
-  std::sort(owned.begin(), owned.end());
-  long counts[2] = {static_cast<long>(owned.size()), static_cast<long>(ids.size())};
-  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_LONG, MPI_SUM, comm_);
-  SHATTER_REQUIRE(counts[0] == total && counts[1] == total,
-                  "ContactPartition: " << counts[1] << " objects listed and " << counts[0] << " owned after RCB for "
-                                       << total);
-  return owned;
+  return to;
 }
 
 }  // namespace shatter

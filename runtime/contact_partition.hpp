@@ -23,20 +23,22 @@ class ContactPartition {
   ContactPartition(const ContactPartition&) = delete;
   ContactPartition& operator=(const ContactPartition&) = delete;
 
-  /// The objects this rank owns after a new partition, ascending (collective). Each rank
-  /// passes the objects it holds now (ids in [0, total), each id on exactly one rank) with
-  /// their points and two weights each (>= 0, object-major), balanced together (Zoltan's
-  /// multi-criteria RCB); it keeps those Zoltan does not export and gains those Zoltan
-  /// imports (its migration lists: no list of every object's part goes to every rank).
-  std::vector<Index> partition(std::span<const Index> ids, std::span<const Vec3> points,
-                               std::span<const float> weights, Index total);
+  /// Words in an object's name.
+  static constexpr int kNameWords = 4;
+  /// Where each object this rank holds goes in a new partition (collective): per object, its
+  /// new rank (this one when it stays). Each rank passes the objects it holds now, named by
+  /// kNameWords numbers >= 0 each (distinct over the ranks), with their points and two
+  /// weights each (>= 0, object-major), balanced together (Zoltan's multi-criteria RCB).
+  /// Only Zoltan's export lists are read: no list of every object's part goes to every rank.
+  std::vector<int> partition(std::span<const Index> names, std::span<const Vec3> points,
+                             std::span<const float> weights);
 
  private:
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   Zoltan_Struct* zz_ = nullptr;
   // The slice handed to Zoltan's callbacks during partition().
-  std::span<const Index> ids_;
+  std::span<const Index> names_;
   std::span<const Vec3> points_;
   std::span<const float> weights_;
 };

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <limits>
 #include <map>
-#include <numeric>
 
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
@@ -19,6 +18,11 @@ namespace {
 template <size_t K>
 void add_nodes(std::span<const std::array<Index, K>> primitives, std::vector<Index>& nodes) {
   for (const auto& p : primitives) nodes.insert(nodes.end(), p.begin(), p.end());
+}
+
+/// Edge {a, b} (surface vertex ids) as one number whose order is that of (a, b).
+std::uint64_t edge_key(Index a, Index b) {
+  return static_cast<std::uint64_t>(a) << 32 | static_cast<std::uint32_t>(b);
 }
 
 Box empty_box() {
@@ -47,18 +51,16 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
   return boxes;
 }
 
-ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-                           const SurfaceVertices& vertices, const Model& model, Index num_nodes,
-                           std::span<const double> node_reach)
-    : dec_(dec), surface_(surface), around_(around), vertices_(vertices), model_(model), num_nodes_(num_nodes),
-      part_reach_(node_reach) {
-  SHATTER_REQUIRE(vertices.whole.size() == surface.vertices.size(),
-                  "ContactPatch: " << vertices.whole.size() << " nodes for " << surface.vertices.size() << " vertices");
-  // The edges are sorted by their first node, so each vertex's are a range.
-  edge_offsets_.assign(surface.vertices.size() + 1, 0);
-  for (const auto& e : surface.edges) ++edge_offsets_[around.position[e[0]] + 1];
-  std::partial_sum(edge_offsets_.begin(), edge_offsets_.end(), edge_offsets_.begin());
-  for (Index k = 0; k < surface.num_vertices(); ++k) {
+ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
+                           const Model& model, Index num_nodes, std::span<const double> node_reach)
+    : dec_(dec), vertices_(vertices), model_(model), num_nodes_(num_nodes), part_reach_(node_reach),
+      home_(std::move(home)) {
+  for (size_t t = 0; t < home_.size(); ++t)
+    for (const Index n : home_[t].nodes) home_at_.emplace_back(n, static_cast<Index>(t));
+  std::sort(home_at_.begin(), home_at_.end());
+  const auto nv = static_cast<Index>(vertices.whole.size());
+  ring_at_.assign(nv, -1);
+  for (Index k = 0; k < nv; ++k) {
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
     const Index n = vertices.node[k];
@@ -73,7 +75,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const ContactSurface& surfa
     if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
-  position_.assign(surface.num_vertices(), -1);
+  position_.assign(nv, -1);
   renumber(kept_);
 }
 
@@ -92,17 +94,15 @@ Index ContactPatch::node(Index whole) const {
   return k;
 }
 
-Index ContactPatch::edge(Index a, Index b) const {
-  const Index at = around_.position[a];
-  const auto first = surface_.edges.begin() + edge_offsets_[at], last = surface_.edges.begin() + edge_offsets_[at + 1];
-  const auto it = std::find(first, last, std::array<Index, 2>{a, b});
-  SHATTER_ASSERT(it != last);
-  return static_cast<Index>(it - surface_.edges.begin());
+long ContactPatch::whole_surface_bytes() const {
+  return static_cast<long>((position_.capacity() + ring_at_.capacity()) * sizeof(Index) + node_mark_.capacity());
 }
 
-Index ContactPatch::surface_primitive(Index q) const {
-  const auto nt = static_cast<Index>(owned_triangles_.size());
-  return q < nt ? owned_triangles_[q] : surface_.num_triangles() + patch_edges_[q - nt];
+Index ContactPatch::owned_primitive(Index q) const {
+  const Index nt = owned_.num_triangles();
+  if (q < nt) return q;
+  const Index e = patch_edge_owned_at_[q - nt];
+  return e < 0 ? -1 : nt + e;
 }
 
 namespace {
@@ -146,28 +146,18 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
     if (plans_[p]) plans_[p] = halo_of(lists_[p]);
 }
 
-void ContactPatch::own(std::span<const Index> primitives) {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  const auto total = nt + static_cast<Index>(surface_.edges.size());
+void ContactPatch::own(const NamedSurface& primitives) {
   owned_once_ = true;
-  owned_triangles_.clear();
-  owned_edges_.clear();
-  owned_mark_.assign(total, 0);
   ContactSurface owned;
-  for (size_t k = 0; k < primitives.size(); ++k) {
-    const Index q = primitives[k];
-    SHATTER_REQUIRE(q >= 0 && q < total && (k == 0 || primitives[k - 1] < q),
-                    "ContactPatch: primitive " << q << " of " << total << " out of range or out of order");
-    owned_mark_[q] = 1;
-    if (q < nt) {
-      owned_triangles_.push_back(q);
-      owned.triangles.push_back(surface_.triangles[q]);
-      owned.body.push_back(surface_.body[q]);
-    } else {
-      owned_edges_.push_back(q - nt);
-      owned.edges.push_back(surface_.edges[q - nt]);
-    }
+  for (const NamedTriangle& t : primitives.triangles) {
+    owned.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    owned.body.push_back(t.body);
   }
+  for (const auto& [a, b] : primitives.edges) owned.edges.push_back({vertex(a), vertex(b)});
+  SHATTER_REQUIRE(std::is_sorted(owned.edges.begin(), owned.edges.end()) &&
+                      std::adjacent_find(owned.edges.begin(), owned.edges.end()) == owned.edges.end(),
+                  "ContactPatch: owned edges not ascending");
+  owned_edges_ = owned.edges;
   add_nodes<3>(owned.triangles, owned.vertices);
   add_nodes<2>(owned.edges, owned.vertices);
   sort_unique(owned.vertices);
@@ -212,7 +202,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
                 Vec3(reach[6 * r + 3], reach[6 * r + 4], reach[6 * r + 5])};
   // Edges as their nodes' whole ids {a, b}, vertices as -(whole id + 1).
   std::vector<std::vector<Index>> to(ranks);
-  for (size_t k = 0; k < owned_edges_.size(); ++k)
+  for (size_t k = 0; k < owned_.edges.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r]))
         for (const Index n : owned_.edges[k]) to[r].push_back(whole(n));
@@ -220,30 +210,46 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
     for (int r = 0; r < ranks; ++r)
       if (boxes_overlap(home.vertices[k], boxes[r]))
         to[r].push_back(-(model_.whole_node(volume_vertices_.vertices[k]) + 1));
-  std::vector<Index> edges(owned_edges_), vertices;
+  // The ghost edges as a << 32 | b (surface vertex ids; a 64-bit sort), then the patch's
+  // edges: the owned ones (ascending) and the ghosts merged, each with its owned edge.
+  std::vector<std::uint64_t> ghosts;
+  std::vector<Index> vertices;
   for (const auto& list : dec_.alltoall(to))
     for (size_t at = 0; at < list.size(); ++at)
       if (list[at] < 0) vertices.push_back(vertex(-list[at] - 1));
-      else edges.push_back(edge(vertex(list[at]), vertex(list[at + 1]))), ++at;
-  sort_unique(edges);
+      else ghosts.push_back(edge_key(vertex(list[at]), vertex(list[at + 1]))), ++at;
+  sort_unique(ghosts);
   sort_unique(vertices);
+  std::vector<std::array<Index, 2>> edges;
+  patch_edge_owned_at_.clear();
+  patch_edge_owned_.clear();
+  for (size_t i = 0, j = 0; i < owned_edges_.size() || j < ghosts.size();) {
+    if (j == ghosts.size() || (i < owned_edges_.size() && edge_key(owned_edges_[i][0], owned_edges_[i][1]) < ghosts[j])) {
+      edges.push_back(owned_edges_[i]);
+      patch_edge_owned_at_.push_back(static_cast<Index>(i++));
+    } else {
+      edges.push_back({static_cast<Index>(ghosts[j] >> 32), static_cast<Index>(ghosts[j] & 0xffffffffu)});
+      patch_edge_owned_at_.push_back(-1);
+      ++j;
+    }
+    patch_edge_owned_.push_back(patch_edge_owned_at_.back() >= 0 ? 1 : 0);
+  }
   // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
   // ~7 times, took a third of reach()'s CPU time on the 76 cubes), then those of the
   // triangles around them, whose normals orient their pairs (activate()).
-  node_mark_.resize(surface_.vertices.size(), 0);
+  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed;
-  for (const Index t : owned_triangles_)
-    for (const Index n : surface_.triangles[t]) add_node(n, needed);
-  for (const Index e : edges)
-    for (const Index n : surface_.edges[e]) add_node(n, needed);
+  for (const auto& t : owned_.triangles)
+    for (const Index n : t) add_node(nodes_[n], needed);
+  for (const auto& e : edges)
+    for (const Index n : e) add_node(n, needed);
   for (const Index n : vertices) add_node(n, needed);
   std::vector<Index> nodes = needed;
   for (const Index n : kept_) add_node(n, nodes);
-  for (size_t k = 0, count = needed.size(); k < count; ++k) {
-    const Index p = around_.position[needed[k]];
-    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i)
-      for (const Index n : surface_.triangles[around_.items[i]]) add_node(n, nodes);
-  }
+  fetch_rings(needed);
+  for (size_t k = 0, count = needed.size(); k < count; ++k)
+    for (const Index t : ring_of(needed[k]))
+      for (const Index n : ring_.triangles[t]) add_node(n, nodes);
   for (const Index n : nodes) node_mark_[n] = 0;
   std::sort(needed.begin(), needed.end());
   std::sort(nodes.begin(), nodes.end());
@@ -254,14 +260,8 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_ = {};
   patch_.triangles = owned_.triangles;
   patch_.body = owned_.body;
-  for (const Index e : edges) {
-    const auto& [a, b] = surface_.edges[e];
-    patch_.edges.push_back({position_[a], position_[b]});
-  }
+  for (const auto& [a, b] : edges) patch_.edges.push_back({position_[a], position_[b]});
   for (const Index n : vertices) patch_.vertices.push_back(position_[n]);
-  patch_edges_ = std::move(edges);
-  patch_edge_owned_.resize(patch_edges_.size());
-  for (size_t k = 0; k < patch_edges_.size(); ++k) patch_edge_owned_[k] = owns(surface_.num_triangles() + patch_edges_[k]);
   auto& lists = lists_[static_cast<int>(PatchPlan::Patch)];
   lists = plan(needed, false);
   plans_[static_cast<int>(PatchPlan::Patch)] = halo_of(lists);
@@ -285,42 +285,115 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (marks kept between searches, cleared after use); surface vertex ids.
-  triangle_mark_.resize(surface_.triangles.size(), 0);
-  node_mark_.resize(surface_.vertices.size(), 0);
+  // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'); surface
+  // vertex ids.
+  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed, triangles;
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) add_node(nodes_[k], needed);
-  for (size_t k = 0, count = needed.size(); k < count; ++k) {
-    const Index p = around_.position[needed[k]];
-    for (Index i = around_.offsets[p]; i < around_.offsets[p + 1]; ++i) {
-      const Index t = around_.items[i];
-      if (!triangle_mark_[t]) triangle_mark_[t] = 1, triangles.push_back(t);
-    }
-  }
-  for (const Index t : triangles) {
-    triangle_mark_[t] = 0;
-    for (const Index n : surface_.triangles[t]) add_node(n, needed);
-  }
+  ring_mark_.resize(ring_.triangles.size(), 0);
+  for (size_t k = 0, count = needed.size(); k < count; ++k)
+    for (const Index t : ring_of(needed[k]))
+      if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
+  for (const Index t : triangles) ring_mark_[t] = 0;
+  std::sort(triangles.begin(), triangles.end(), [&](Index a, Index b) { return ring_keys_[a] < ring_keys_[b]; });
+  for (const Index t : triangles)
+    for (const Index n : ring_.triangles[t]) add_node(n, needed);
   sort_marked(needed);
-  std::sort(triangles.begin(), triangles.end());
-  // reach() holds the triangles around the patch's nodes in the patch. Only the triangles,
-  // their vertices and the vertex -> triangle lists are made (surface_normal's needs).
+  // reach() holds the rings' nodes in the patch. Only the triangles, their vertices and the
+  // vertex -> triangle lists are made (surface_normal's needs).
   normals_ = {};
-  std::vector<char> vertex(nodes_.size(), 0);
+  std::vector<char> vertex_mark(nodes_.size(), 0);
   for (const Index t : triangles) {
-    const auto& [a, b, c] = surface_.triangles[t];
+    const auto& [a, b, c] = ring_.triangles[t];
     normals_.triangles.push_back({position_[a], position_[b], position_[c]});
-    normals_.body.push_back(surface_.body[t]);
-    for (const Index n : normals_.triangles.back()) vertex[n] = 1;
+    normals_.body.push_back(ring_.body[t]);
+    for (const Index n : normals_.triangles.back()) vertex_mark[n] = 1;
   }
-  for (size_t k = 0; k < vertex.size(); ++k)
-    if (vertex[k]) normals_.vertices.push_back(static_cast<Index>(k));
+  for (size_t k = 0; k < vertex_mark.size(); ++k)
+    if (vertex_mark[k]) normals_.vertices.push_back(static_cast<Index>(k));
   normals_around_ = vertex_triangles(normals_);
   auto& lists = lists_[static_cast<int>(PatchPlan::Active)];
   lists = plan(needed, true);
   plans_[static_cast<int>(PatchPlan::Active)] = halo_of(lists);
   active_fresh_ = true;
+}
+
+Index ContactPatch::ring_triangle(const NamedTriangle& t) {
+  const auto [it, fresh] = ring_name_.try_emplace(t.name, ring_.num_triangles());
+  if (fresh) {
+    ring_.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    ring_.body.push_back(t.body);
+    // The name (element, face 0-3, sub-triangle 0-3) as one number of the same order.
+    ring_keys_.push_back(16 * static_cast<std::int64_t>(t.name[0]) + 4 * t.name[1] + t.name[2]);
+  }
+  return it->second;
+}
+
+std::span<const Index> ContactPatch::ring_of(Index v) const {
+  SHATTER_ASSERT(ring_at_[v] >= 0);
+  const Index k = ring_at_[v];
+  return {ring_items_.data() + ring_offsets_[k], static_cast<size_t>(ring_offsets_[k + 1] - ring_offsets_[k])};
+}
+
+void ContactPatch::fetch_rings(std::span<const Index> vertices) {
+  // Each vertex's volume owner holds every triangle around it (home_triangles). Asked for a
+  // list of vertices, it answers with the triangles around them, each once (kind-free: 7
+  // numbers, name, nodes, body), in name order.
+  const int ranks = dec_.size(), me = dec_.rank();
+  std::vector<std::vector<Index>> ask(ranks);
+  std::vector<Index> mine;
+  for (const Index v : vertices)
+    if (ring_at_[v] < 0) {
+      if (vertices_.owner[v] == me) mine.push_back(v);
+      else ask[vertices_.owner[v]].push_back(vertices_.whole[v]);
+    }
+  for (std::vector<Index>& list : ask) std::sort(list.begin(), list.end());
+  const auto around_home = [&](Index whole, std::vector<Index>& out) {
+    const auto first = std::lower_bound(home_at_.begin(), home_at_.end(), std::pair<Index, Index>(whole, -1));
+    for (auto it = first; it != home_at_.end() && it->first == whole; ++it) out.push_back(it->second);
+  };
+  const std::vector<std::vector<Index>> asked = dec_.alltoall(ask);
+  std::vector<std::vector<Index>> reply(ranks);
+  for (int r = 0; r < ranks; ++r) {
+    std::vector<Index> triangles;
+    for (const Index whole : asked[r]) around_home(whole, triangles);
+    sort_unique(triangles);
+    for (const Index t : triangles) {
+      const NamedTriangle& tri = home_[t];
+      reply[r].insert(reply[r].end(), tri.name.begin(), tri.name.end());
+      reply[r].insert(reply[r].end(), tri.nodes.begin(), tri.nodes.end());
+      reply[r].push_back(tri.body);
+    }
+  }
+  const std::vector<std::vector<Index>> answers = dec_.alltoall(reply);
+  // Each ring is appended whole to ring_items_ (one array: the rings are read together at
+  // every search).
+  const auto append = [&](Index v, const std::vector<Index>& ring) {
+    ring_at_[v] = static_cast<Index>(ring_offsets_.size() - 1);
+    ring_items_.insert(ring_items_.end(), ring.begin(), ring.end());
+    ring_offsets_.push_back(static_cast<Index>(ring_items_.size()));
+  };
+  for (const Index v : mine) {
+    std::vector<Index> triangles, ring;
+    around_home(vertices_.whole[v], triangles);
+    for (const Index t : triangles) ring.push_back(ring_triangle(home_[t]));
+    append(v, ring);
+  }
+  // An asked vertex's ring: the answered triangles that hold it (its owner sent them all).
+  for (int r = 0; r < ranks; ++r) {
+    std::vector<std::vector<Index>> rings(ask[r].size());
+    const std::vector<Index>& list = answers[r];
+    for (size_t i = 0; i + 7 <= list.size(); i += 7) {
+      const NamedTriangle t{{list[i], list[i + 1], list[i + 2]}, {list[i + 3], list[i + 4], list[i + 5]},
+                            static_cast<int>(list[i + 6])};
+      const Index at = ring_triangle(t);
+      for (const Index whole : t.nodes)
+        if (const auto it = std::lower_bound(ask[r].begin(), ask[r].end(), whole); it != ask[r].end() && *it == whole)
+          rings[it - ask[r].begin()].push_back(at);
+    }
+    for (size_t k = 0; k < ask[r].size(); ++k) append(vertex(ask[r][k]), rings[k]);
+  }
 }
 
 ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {

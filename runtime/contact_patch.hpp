@@ -25,6 +25,7 @@
 #include "contact/candidates.hpp"
 #include "contact/dcr.hpp"
 #include "contact/surface.hpp"
+#include "runtime/named_surface.hpp"
 
 namespace shatter {
 
@@ -55,30 +56,25 @@ enum class PatchPlan { Owned, Patch, Active };
 
 class ContactPatch {
  public:
-  /// surface, around: the contact surface in surface vertex ids (vertex k is the surface's
-  /// k-th node: vertices = 0, 1, ...) and its vertex -> triangle lists; vertices: what is
-  /// known of each surface vertex; all three held by the caller for the patch's lifetime (a
-  /// new surface needs a new patch). model: the part (its nodes' whole ids, its bodies);
-  /// num_nodes: the length of the part's nodal arrays; node_reach: per part node, its reach
-  /// (inflated_boxes; empty without shells), held by the caller.
-  ContactPatch(const Decomposition& dec, const ContactSurface& surface, const VertexTriangles& around,
-               const SurfaceVertices& vertices, const Model& model, Index num_nodes,
-               std::span<const double> node_reach = {});
+  /// vertices: what is known of each vertex of the contact surface (vertex k: the surface's
+  /// k-th node, ascending in whole id), held by the caller for the patch's lifetime (a new
+  /// surface needs a new patch); home: the surface's triangles around the vertices whose
+  /// volume owner this rank is (home_triangles), in name order. model: the part (its nodes'
+  /// whole ids, its bodies); num_nodes: the length of the part's nodal arrays; node_reach:
+  /// per part node, its reach (inflated_boxes; empty without shells), held by the caller.
+  ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
+               const Model& model, Index num_nodes, std::span<const double> node_reach = {});
   ~ContactPatch();
   ContactPatch(const ContactPatch&) = delete;
   ContactPatch& operator=(const ContactPatch&) = delete;
 
-  /// A new ownership: the primitives this rank owns, ascending (triangle t as t, edge e as
-  /// the number of triangles + e); no rank learns the others'. Plans the states of the owned
+  /// A new ownership: the triangles and edges this rank owns, named (triangles in name
+  /// order, edges ascending); no rank learns the others'. Plans the states of the owned
   /// primitives' nodes (PatchPlan::Owned; collective).
-  void own(std::span<const Index> primitives);
+  void own(const NamedSurface& primitives);
   bool owned_any() const { return owned_once_; }
-  /// Whether this rank owns primitive q (numbered as in own()).
-  bool owns(Index q) const { return owned_mark_[q] != 0; }
-  /// The triangles and edges owned here (surface indices, ascending) and their nodes
-  /// (patch node ids).
-  std::span<const Index> owned_triangles() const { return owned_triangles_; }
-  std::span<const Index> owned_edges() const { return owned_edges_; }
+  /// The owned triangles and edges, in own()'s order, in patch node ids. Owned primitive k is
+  /// triangle k, or edge k - the number of triangles.
   const ContactSurface& owned() const { return owned_; }
 
   /// The ghosts for a search over x_old -> x_new (the part's arrays: its home vertices'
@@ -100,11 +96,12 @@ class ContactPatch {
   /// The patch's inflated boxes for the search (inflated_boxes of patch(), with the owned
   /// primitives' from reach(); their states must be unchanged since, the rest here).
   SweptBoxes patch_boxes(double margin) const;
-  /// The primitive (numbered as in own()) of a primitive of patch() (as in OwnedPairs).
-  Index surface_primitive(Index patch_primitive) const;
+  /// The owned primitive (numbered as in owned()) of a primitive of patch() (as in
+  /// OwnedPairs), -1 for a ghost edge.
+  Index owned_primitive(Index patch_primitive) const;
   /// The triangles whose normals the active pairs read (those around their nodes), in
-  /// surface order, and their vertices (no edges), with their vertex -> triangle lists
-  /// (patch node ids).
+  /// name order (the one-rank surface's), and their vertices (no edges), with their vertex ->
+  /// triangle lists (patch node ids).
   const ContactSurface& normals() const { return normals_; }
   const VertexTriangles& normals_around() const { return normals_around_; }
   /// The surface vertices whose volume owner this rank is, ascending (part node ids).
@@ -126,12 +123,12 @@ class ContactPatch {
   Index whole(Index k) const { return vertices_.whole[nodes_[k]]; }
   /// The rank that owns patch node k (its volume owner).
   int owner(Index k) const { return vertices_.owner[nodes_[k]]; }
-  /// The volume owner of surface vertex v.
-  int vertex_owner(Index v) const { return vertices_.owner[v]; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
   std::span<Vec3> v() { return v_; }
+  /// The bytes of its arrays sized by the whole surface (per surface vertex).
+  long whole_surface_bytes() const;
   /// Per patch node: its reach (empty without shells).
   std::span<const double> node_reach() const { return reach_; }
   /// Per patch node: its inverse mass and held components (as a number: bit k = component
@@ -184,29 +181,40 @@ class ContactPatch {
   void add_node(Index n, std::vector<Index>& nodes);
   /// Clears the marks of `nodes` (from add_node) and sorts them.
   void sort_marked(std::vector<Index>& nodes);
-  /// The surface index of the edge {a, b} (a < b, surface vertex ids).
-  Index edge(Index a, Index b) const;
+  /// The rings (the triangles around them) of the listed surface vertices that have none yet,
+  /// from their volume owners (collective).
+  void fetch_rings(std::span<const Index> vertices);
+  /// The index in ring_ of triangle t, added if new.
+  Index ring_triangle(const NamedTriangle& t);
+  /// The ring of surface vertex v (fetched).
+  std::span<const Index> ring_of(Index v) const;
 
   const Decomposition& dec_;
-  const ContactSurface& surface_;
-  const VertexTriangles& around_;
   const SurfaceVertices& vertices_;
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
-  std::vector<Index> edge_offsets_;  ///< surface_.edges from vertex k's on (CSR by first node)
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
   std::vector<Index> kept_;   ///< the surface vertices whose part rows the time loop keeps (load())
   bool owned_once_ = false;
-  std::vector<Index> owned_triangles_, owned_edges_;
-  std::vector<std::uint8_t> owned_mark_;  ///< per primitive (numbered as in own()), 1 if owned
+  std::vector<std::array<Index, 2>> owned_edges_;  ///< owned_.edges in surface vertex ids (ascending)
   ContactSurface owned_, patch_;
   SweptBoxes owned_boxes_;                  ///< inflated boxes of owned_ at the last reach()
-  std::vector<Index> patch_edges_;          ///< per edge of patch_: its surface index
+  std::vector<Index> patch_edge_owned_at_;      ///< per edge of patch_: its owned edge, -1 for a ghost
   std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
   ContactSurface normals_;
   VertexTriangles normals_around_;
-  std::vector<std::uint8_t> triangle_mark_, node_mark_;  ///< scratch of reach() and activate(), 0 between calls
+  std::vector<std::uint8_t> node_mark_;  ///< scratch of reach() and activate(), 0 between calls
+  // The rings (docs/parallel.md "Patches with their own topology", step 2): the triangles
+  // around the patch's vertices, which orient its pairs, from the vertices' volume owners.
+  std::vector<NamedTriangle> home_;           ///< around the vertices whose volume owner this rank is
+  std::vector<std::pair<Index, Index>> home_at_;  ///< (whole node, home_ index), ascending
+  ContactSurface ring_;                       ///< every triangle fetched, once (triangles and bodies; surface vertex ids)
+  std::vector<std::int64_t> ring_keys_;  ///< per triangle of ring_: its name as one number, in name order
+  std::vector<std::uint8_t> ring_mark_;  ///< per triangle of ring_: scratch of activate(), 0 between calls
+  std::map<std::array<Index, 3>, Index> ring_name_;  ///< ring_'s index of a triangle's name
+  std::vector<Index> ring_at_;  ///< per surface vertex: its ring (k: ring_offsets_[k]), -1 before it is fetched
+  std::vector<Index> ring_offsets_{0}, ring_items_;  ///< the rings fetched, CSR: ring_ indices, name order
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet

@@ -11,6 +11,7 @@
 #include "runtime/contact_partition.hpp"
 #include "runtime/contact_patch.hpp"
 #include "runtime/decomposition.hpp"
+#include "runtime/named_surface.hpp"
 #include "runtime/parallel.hpp"
 #include "runtime/patch_ranks.hpp"
 #include "runtime/timed.hpp"
@@ -38,8 +39,9 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
     shell_body_[shell.body] = 1;
     for (Index v = 0; v < shell.mesh.num_vertices(); ++v) reach_[shell.first_node + v] = 0.5 * shell.thickness;
   }
-  // A part of the model brings the whole model's surface, in surface vertex ids.
-  if (model.is_part()) set_surface(make_contact_surface(model.part.surface), model.mesh);
+  // A part holds no triangles of the surface but its own elements' (named_surface.hpp): its
+  // patch names them and gets the rest from the other ranks.
+  if (model.is_part()) set_surface({}, model.mesh);
   else rebuild(model.mesh);
 }
 
@@ -105,12 +107,10 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
     return;
   }
   set_vertices(mesh);
-  vertex_triangles_ = vertex_triangles(surface_);
+  vertex_triangles_ = {};
   ranks_.reset();
-  patch_ = std::make_unique<ContactPatch>(*dec_, surface_, vertex_triangles_, vertices_, model_, mesh.num_nodes(),
-                                          reach_);
+  patch_ = std::make_unique<ContactPatch>(*dec_, vertices_, home_triangles(), model_, mesh.num_nodes(), reach_);
   ranks_ = std::make_unique<PatchRanks>(*patch_, *dec_);
-  weight_.assign(surface_.triangles.size() + surface_.edges.size(), 0.0f);
   repartition_ = true;
 }
 
@@ -196,24 +196,17 @@ void ContactStage::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
 // candidates + 0.01 (the filter's work, and a bound on DCR's; balanced alone,
 // one rank of two held 60 % of the 76 cubes' triangles and searched 1.3x
 // longer than the other). Before the first partition a primitive
-// belongs to the volume owner of its first node. The primitives are
+// belongs to its first owner (first_owned). The primitives are
 // re-partitioned at a search (i.e. when the surface moved past the reuse margin)
 // if the surface was rebuilt, or if the candidates per rank are out of balance by
 // more than 10 % (largest over mean), and then searched again.
 void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  if (!patch_->owned_any()) {
-    std::vector<Index> first_owned;
-    for (Index q = 0; q < nt + static_cast<Index>(surface_.edges.size()); ++q)
-      if (patch_->vertex_owner(q < nt ? surface_.triangles[q][0] : surface_.edges[q - nt][0]) == dec_->rank())
-        first_owned.push_back(q);
-    patch_->own(first_owned);
-  }
+  if (!patch_->owned_any()) own(first_owned());
   // The owned primitives' states start the search (their boxes, the reach).
   exchange(x_old, x_new, v, PatchPlan::Owned);
   for (bool repartitioned = false;; repartitioned = true) {
     if (repartition_) {
-      patch_->own(partition());
+      partition();
       exchange(x_old, x_new, v, PatchPlan::Owned);
       repartition_ = false;
       ++profile_.repartitions;
@@ -230,7 +223,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     for (size_t k = 0; k < found.pairs.size(); ++k) {
       if (excluded(surface_pair(found.pairs[k]))) continue;
       pairs_.push_back(found.pairs[k]);
-      weight_[patch_->surface_primitive(found.primitive[k])] += 1.0f;
+      weight_[patch_->owned_primitive(found.primitive[k])] += 1.0f;
     }
     profile_.search_cpu_seconds += thread_cpu_seconds() - cpu0;
     const long mine = static_cast<long>(pairs_.size());
@@ -242,25 +235,95 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
-std::vector<Index> ContactStage::partition() {
-  const auto nt = static_cast<Index>(surface_.triangles.size());
-  const ContactSurface& owned = patch_->owned();
+NamedSurface ContactStage::first_owned() const {
+  if (model_.is_part()) return owned_surface(model_, *dec_);
+  // A whole model on ranks (shells, cracks in contact): each primitive by the volume owner
+  // of its first node, a triangle named by its place in the surface (t, 0, 0).
+  NamedSurface owned;
+  const std::vector<Index>& whole = vertices_.whole;
+  for (Index t = 0; t < surface_.num_triangles(); ++t) {
+    const auto& n = surface_.triangles[t];
+    if (vertices_.owner[n[0]] == dec_->rank())
+      owned.triangles.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
+  }
+  for (const auto& [a, b] : surface_.edges)
+    if (vertices_.owner[a] == dec_->rank()) owned.edges.push_back({whole[a], whole[b]});
+  return owned;
+}
+
+std::vector<NamedTriangle> ContactStage::home_triangles() const {
+  if (model_.is_part()) return shatter::home_triangles(model_, *dec_);
+  // A whole model on ranks: named as in first_owned().
+  std::vector<NamedTriangle> home;
+  const std::vector<Index>& whole = vertices_.whole;
+  for (Index t = 0; t < surface_.num_triangles(); ++t) {
+    const auto& n = surface_.triangles[t];
+    const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
+    if (mine(n[0]) || mine(n[1]) || mine(n[2]))
+      home.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
+  }
+  return home;
+}
+
+void ContactStage::partition() {
+  // Each primitive as its name (4 words: kind, then a triangle's name or an edge's nodes),
+  // its centre at the patch's x(n+1) and its weights.
+  const ContactSurface& at = patch_->owned();
   const std::span<const Vec3> x = patch_->x_new();
-  std::vector<Index> ids;
+  const size_t nt = owned_.triangles.size(), ne = owned_.edges.size();
+  std::vector<Index> names;
   std::vector<Vec3> points;
   std::vector<float> weights;
-  for (size_t k = 0; k < owned.triangles.size(); ++k) {
-    const auto& n = owned.triangles[k];
-    ids.push_back(patch_->owned_triangles()[k]);
+  for (size_t k = 0; k < nt; ++k) {
+    const auto& n = at.triangles[k];
+    names.insert(names.end(), {0, owned_.triangles[k].name[0], owned_.triangles[k].name[1], owned_.triangles[k].name[2]});
     points.push_back((x[n[0]] + x[n[1]] + x[n[2]]) / 3.0);
   }
-  for (size_t k = 0; k < owned.edges.size(); ++k) {
-    const auto& n = owned.edges[k];
-    ids.push_back(nt + patch_->owned_edges()[k]);
+  for (size_t k = 0; k < ne; ++k) {
+    const auto& n = at.edges[k];
+    names.insert(names.end(), {1, owned_.edges[k][0], owned_.edges[k][1], 0});
     points.push_back(0.5 * (x[n[0]] + x[n[1]]));
   }
-  for (const Index q : ids) weights.insert(weights.end(), {1.0f, 0.01f + weight_[q]});
-  return partition_->partition(ids, points, weights, static_cast<Index>(weight_.size()));
+  for (const float w : weight_) weights.insert(weights.end(), {1.0f, 0.01f + w});
+  const std::vector<int> to = partition_->partition(names, points, weights);
+  // The primitives that leave go to their new ranks with their data (a triangle: kind, name,
+  // nodes, body; an edge: kind, nodes).
+  const int me = dec_->rank();
+  NamedSurface kept;
+  std::vector<std::vector<Index>> out(dec_->size());
+  for (size_t k = 0; k < nt; ++k) {
+    const NamedTriangle& t = owned_.triangles[k];
+    if (to[k] == me) kept.triangles.push_back(t);
+    else
+      out[to[k]].insert(out[to[k]].end(), {0, t.name[0], t.name[1], t.name[2], t.nodes[0], t.nodes[1], t.nodes[2], t.body});
+  }
+  for (size_t k = 0; k < ne; ++k) {
+    if (to[nt + k] == me) kept.edges.push_back(owned_.edges[k]);
+    else out[to[nt + k]].insert(out[to[nt + k]].end(), {1, owned_.edges[k][0], owned_.edges[k][1]});
+  }
+  for (const auto& list : dec_->alltoall(out))
+    for (size_t i = 0; i < list.size();)
+      if (list[i] == 0) {
+        kept.triangles.push_back({{list[i + 1], list[i + 2], list[i + 3]}, {list[i + 4], list[i + 5], list[i + 6]},
+                                  static_cast<int>(list[i + 7])});
+        i += 8;
+      } else {
+        kept.edges.push_back({list[i + 1], list[i + 2]});
+        i += 3;
+      }
+  std::sort(kept.triangles.begin(), kept.triangles.end(),
+            [](const NamedTriangle& a, const NamedTriangle& b) { return a.name < b.name; });
+  std::sort(kept.edges.begin(), kept.edges.end());
+  const long before = static_cast<long>(nt + ne), after = static_cast<long>(kept.triangles.size() + kept.edges.size());
+  const std::vector<long> sums = dec_->sum(std::vector<long>{before, after});
+  SHATTER_REQUIRE(sums[0] == sums[1], "ContactStage: " << sums[0] << " primitives before RCB, " << sums[1] << " after");
+  own(std::move(kept));
+}
+
+void ContactStage::own(NamedSurface primitives) {
+  owned_ = std::move(primitives);
+  weight_.assign(owned_.triangles.size() + owned_.edges.size(), 0.0f);
+  patch_->own(owned_);
 }
 
 std::vector<std::int32_t> ContactStage::patch_rigid_bodies(const DcrRigidBodies& rigid) const {
@@ -276,17 +339,25 @@ ContactBalance ContactStage::balance() const {
   const ContactProfile& p = profile_;
   ContactBalance b{p.owned_pairs,     p.owned_pairs, p.owned_pairs,        p.candidates,
                    p.states_posted,   p.state_bytes, p.found_bytes,        p.search_cpu_seconds,
-                   p.sweep_cpu_seconds};
+                   p.sweep_cpu_seconds, whole_surface_bytes()};
   if (dec_) {
-    long most[4] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max},
+    long most[5] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max, b.whole_surface_bytes_max},
          sum[3] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum};
     double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
-    MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_LONG, MPI_MAX, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_LONG, MPI_MAX, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_LONG, MPI_SUM, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
-    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1]};
+    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4]};
   }
   return b;
+}
+
+long ContactStage::whole_surface_bytes() const {
+  auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
+  return b(surface_.triangles) + b(surface_.body) + b(surface_.edges) + b(surface_.vertices) +
+         b(vertex_triangles_.offsets) + b(vertex_triangles_.items) + b(vertex_triangles_.position) +
+         b(vertices_.whole) + b(vertices_.node) + b(vertices_.owner) + b(vertices_.body) + b(body_) + b(twin_of_) +
+         (patch_ ? patch_->whole_surface_bytes() : 0);
 }
 
 std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine) {

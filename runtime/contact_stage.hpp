@@ -36,6 +36,7 @@
 #include "contact/surface.hpp"
 #include "runtime/contact_patch.hpp"
 #include "runtime/model.hpp"
+#include "runtime/named_surface.hpp"
 
 namespace shatter {
 
@@ -78,6 +79,7 @@ struct ContactBalance {
   long states_posted_sum = 0;  ///< ContactProfile::states_posted
   long state_bytes_max = 0, found_bytes_max = 0;
   double search_cpu_max = 0, sweep_cpu_max = 0;
+  long whole_surface_bytes_max = 0;  ///< ContactStage::whole_surface_bytes
 };
 
 class Decomposition;
@@ -116,9 +118,14 @@ class ContactStage {
   void rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip = {},
                std::span<const std::array<Index, 2>> twins = {});
 
-  /// The contact surface: in the mesh's node ids on one rank; on several, in surface vertex
-  /// ids (vertex k is the surface's k-th node, surface_nodes()[k] here).
+  /// The contact surface: in the mesh's node ids on one rank; on several holding the whole
+  /// model, in surface vertex ids (vertex k is the surface's k-th node, surface_nodes()[k]
+  /// here); on a part, empty (each rank's patch holds its share).
   const ContactSurface& surface() const { return surface_; }
+  /// The number of triangles of the whole contact surface.
+  Index surface_triangles() const {
+    return model_.is_part() ? model_.part.surface_triangles : surface_.num_triangles();
+  }
   /// The surface's nodes, ascending (mesh node ids; on several ranks, -1 for a node the
   /// part does not hold).
   std::span<const Index> surface_nodes() const { return dec_ ? vertices_.node : surface_.vertices; }
@@ -138,6 +145,10 @@ class ContactStage {
   const ContactProfile& profile() const { return profile_; }
   /// profile() over the ranks (collective).
   ContactBalance balance() const;
+  /// The bytes of the contact arrays this rank holds that are sized by the whole contact
+  /// surface (its topology, per-vertex tables and scratch; the part's own per-vertex tables
+  /// are model bytes): on a part, the term that still grows with the whole model.
+  long whole_surface_bytes() const;
   /// The reuse margin delta, m: contact.search_margin (default a tenth) times the
   /// median surface edge length.
   double margin() const { return margin_; }
@@ -164,9 +175,18 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine` (patch ids), in
   /// whole ids, named in unresolved_ (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine);
-  /// The primitives owned here after an RCB partition of the owned ones at the patch's
-  /// x(n+1), weighted by their candidates.
-  std::vector<Index> partition();
+  /// The primitives owned here before the first partition: on a part, those it names
+  /// (owned_surface: a triangle by its element's owner, an edge by its smallest-named
+  /// triangle's); on a whole model, each by the volume owner of its first node.
+  NamedSurface first_owned() const;
+  /// The surface's triangles around the vertices whose volume owner this rank is, named as in
+  /// first_owned(): on a part from its mesh (home_triangles), on a whole model from the surface.
+  std::vector<NamedTriangle> home_triangles() const;
+  /// A new RCB partition of the owned primitives at the patch's x(n+1), weighted by their
+  /// candidates; the primitives that leave go to their new ranks with their data (collective).
+  void partition();
+  /// The primitives owned here become `primitives` (owned_, the patch's, the weights).
+  void own(NamedSurface primitives);
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
@@ -202,7 +222,8 @@ class ContactStage {
   std::unique_ptr<ContactPartition> partition_;
   std::unique_ptr<ContactPatch> patch_;  ///< of surface_
   std::unique_ptr<PatchRanks> ranks_;    ///< DCR's exchanges between the patches
-  std::vector<float> weight_;            ///< per triangle, then edge: candidates at the last search (owned ones)
+  NamedSurface owned_;                   ///< the primitives owned here
+  std::vector<float> weight_;            ///< per owned primitive (triangles, then edges): candidates at the last search
   bool repartition_ = true;              ///< partition at the next search
 };
 

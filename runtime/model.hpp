@@ -10,7 +10,6 @@
 #include <tuple>
 #include <vector>
 
-#include "contact/surface.hpp"
 #include "kernels/neo_hookean.hpp"
 #include "kernels/tet10.hpp"
 #include "mesh/mesh.hpp"
@@ -80,12 +79,13 @@ struct Model {
     std::vector<Index> node_rank_offsets;
     std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
-    /// Contact scenes: the whole model's contact surface (build_contact_surface) in
-    /// surface vertex ids (vertex k: the surface's k-th node, ascending in whole id), and
-    /// per surface vertex its whole id, its volume owner and its body. The part holds the
-    /// rows of its elements' nodes and of the rigid bodies' surface nodes only
-    /// (docs/parallel.md "Patches with their own topology", step 4).
-    std::vector<SurfaceTriangle> surface;
+    /// Contact scenes: of the whole model's contact surface (build_contact_surface), the
+    /// number of triangles and, per surface vertex (vertex k: the surface's k-th node,
+    /// ascending in whole id), its whole id, its volume owner and its body. The triangles
+    /// are not held: each rank names those of its own elements (named_surface.hpp). The part
+    /// holds the rows of its elements' nodes and of the rigid bodies' surface nodes only
+    /// (docs/parallel.md "Patches with their own topology", steps 2 and 4).
+    Index surface_triangles = 0;
     std::vector<Index> surface_node;
     std::vector<int> surface_owner, surface_body;
     double surface_edge = 0;  ///< the surface's median edge length (median_edge_length)
@@ -117,7 +117,7 @@ void for_each_array(M& m, F f) {
   f(m.tet4_Dm_inv), f(m.tet10_ref), f(m.element_volume), f(m.element_node_mass), f(m.mass), f(m.bc_mask);
   f(m.bc_velocity), f(m.bc_condition), f(m.load_faces), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
-  f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index), f(m.part.surface);
+  f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index);
   f(m.part.surface_node), f(m.part.surface_owner), f(m.part.surface_body);
 }
 

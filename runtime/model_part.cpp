@@ -29,7 +29,7 @@ struct Partition {
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
   // Contact scenes: the whole model's surface as the parts hold it (Model::Part).
-  std::vector<SurfaceTriangle> surface;
+  Index surface_triangles = 0;
   std::vector<Index> surface_node;
   std::vector<int> surface_owner, surface_body;
   double surface_edge = 0;
@@ -48,13 +48,9 @@ Partition partition(const Model& whole, int ranks) {
   if (!whole.scene.contact) return p;
   // The surface in surface vertex ids, and what every part knows of each vertex.
   const ContactSurface surface = build_contact_surface(mesh);
-  const VertexTriangles around = vertex_triangles(surface);
   p.surface_edge = median_edge_length(surface, mesh.reference);
+  p.surface_triangles = surface.num_triangles();
   p.surface_node = surface.vertices;
-  for (size_t t = 0; t < surface.triangles.size(); ++t) {
-    const auto& [a, b, c] = surface.triangles[t];
-    p.surface.push_back({{around.position[a], around.position[b], around.position[c]}, surface.body[t]});
-  }
   for (const Index n : surface.vertices) {
     p.surface_owner.push_back(p.touch.of(n)[0]);
     p.surface_body.push_back(mesh.node_body[n]);
@@ -153,7 +149,7 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   }
   mesh.build_node_elements();
   m.load_faces = held_load_faces(whole.load_faces, part.element_index);
-  part.surface = p.surface;
+  part.surface_triangles = p.surface_triangles;
   part.surface_node = p.surface_node;
   part.surface_owner = p.surface_owner;
   part.surface_body = p.surface_body;
@@ -192,11 +188,12 @@ void cut_parts(const Model& whole, int ranks, const std::function<void(int, Mode
 }
 
 void put_part(const Model& m, const std::function<void(const void*, std::uint64_t)>& put) {
-  const std::uint64_t head[7] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
+  const std::uint64_t head[8] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
                                  static_cast<std::uint64_t>(m.part.whole_elements),
                                  static_cast<std::uint64_t>(m.part.whole_nodes),
                                  static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint,
-                                 std::bit_cast<std::uint64_t>(m.part.surface_edge)};
+                                 std::bit_cast<std::uint64_t>(m.part.surface_edge),
+                                 static_cast<std::uint64_t>(m.part.surface_triangles)};
   put(head, sizeof head);
   for_each_array(m, [&](const auto& v) {
     const std::uint64_t n = v.size();
@@ -206,7 +203,7 @@ void put_part(const Model& m, const std::function<void(const void*, std::uint64_
 }
 
 bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std::uint64_t)>& get) {
-  std::uint64_t head[7];
+  std::uint64_t head[8];
   if (limit < sizeof head) return false;
   get(head, sizeof head);
   limit -= sizeof head;
@@ -217,6 +214,7 @@ bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std
   m.part.whole_bc_nodes = static_cast<Index>(head[4]);
   m.part.fingerprint = head[5];
   m.part.surface_edge = std::bit_cast<double>(head[6]);
+  m.part.surface_triangles = static_cast<Index>(head[7]);
   bool fits = true;
   for_each_array(m, [&](auto& v) {
     std::uint64_t n = 0;

@@ -19,7 +19,7 @@ namespace shatter {
 namespace {
 
 constexpr std::array<char, 16> kMagic{"shatter parts"};
-constexpr std::uint64_t kVersion = 2;
+constexpr std::uint64_t kVersion = 3;
 
 /// A file written through a running hash; the hash goes last.
 class HashedWriter {

@@ -8,11 +8,11 @@
 //
 // Layout of DIR/part-<r>-of-<R>.bin (native byte order, 8-byte words):
 //   magic      16 bytes "shatter parts" padded with zeros
-//   version    uint64 1
+//   version    uint64 3 (2: the surface's triangles in the part; 1: and its nodes' rows)
 //   rank, ranks  uint64: r and R
 //   physics    uint64 length, then the text of physics_keys() of the scene it
 //              was cut from (a run names the first key that differs)
-//   part       put_part()'s bytes: a header of 6 words, then every array of
+//   part       put_part()'s bytes: a header of 8 words, then every array of
 //              the part as its length (uint64) and its elements
 //   fnv1a64    uint64: FNV-1a of every byte before it (runtime/fnv1a.hpp)
 #include <mpi.h>

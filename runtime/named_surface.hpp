@@ -1,0 +1,54 @@
+#pragma once
+// The contact surface listed where its faces are (docs/parallel.md "Patches with
+// their own topology", step 2): each rank names the boundary triangles of its
+// owned elements by (whole element, local face, sub-triangle), the one-rank
+// surface's order, and lists the edges it owns first: those whose
+// smallest-named triangle is one of its own. Over the ranks every triangle and
+// every edge of the whole surface is listed once, and the triangles in name order
+// are the one-rank surface's.
+//
+// Why a part decides alone: its first ghost layer holds every element sharing a
+// node with an owned one, so the star of every node of an owned element is held.
+// A face through such a node has its face neighbour in that star, so the part
+// tells boundary faces from inner ones there as the whole mesh does; and every
+// boundary triangle through an edge of an owned triangle is a face of an element
+// in the star of the edge's nodes.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "contact/surface.hpp"
+#include "kernels/types.hpp"
+
+namespace shatter {
+
+class Decomposition;
+struct Model;
+
+/// A triangle of the contact surface named by where it comes from.
+struct NamedTriangle {
+  std::array<Index, 3> name;   ///< whole element, local face (outward face), sub-triangle (face_triangles)
+  std::array<Index, 3> nodes;  ///< whole node ids, counter-clockwise seen from outside
+  int body = 0;                ///< the element's body
+  friend bool operator==(const NamedTriangle&, const NamedTriangle&) = default;
+};
+
+/// A rank's share of the contact surface's primitives.
+struct NamedSurface {
+  std::vector<NamedTriangle> triangles;     ///< the owned elements' boundary triangles, ascending names
+  std::vector<std::array<Index, 2>> edges;  ///< the edges owned first here: whole ids a < b, ascending
+};
+
+/// This rank's share of the surface of the model's mesh (a part with its first ghost layer,
+/// or a whole model), but the faces in `skip` (local (element, face), ascending).
+NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::span<const MeshFace> skip = {});
+
+/// The boundary triangles through the nodes whose volume owner this rank is
+/// (Decomposition::node_owner), in name order: around each such node, every triangle of the
+/// whole surface, those whose normals the surface normal there sums (surface_normal). The
+/// owner holds the node's star, so it classifies the faces through the node as the whole
+/// mesh does.
+std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec,
+                                          std::span<const MeshFace> skip = {});
+
+}  // namespace shatter
