@@ -82,7 +82,7 @@ ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vert
 ContactPatch::~ContactPatch() = default;
 
 Index ContactPatch::vertex(Index whole) const {
-  const std::vector<Index>& ids = vertices_.whole;
+  const std::span<const Index> ids = vertices_.whole;
   const auto it = std::lower_bound(ids.begin(), ids.end(), whole);
   SHATTER_ASSERT(it != ids.end() && *it == whole);
   return static_cast<Index>(it - ids.begin());

@@ -42,12 +42,14 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
                           double margin, std::span<const double> reach = {});
 
 /// What every rank knows of each vertex of the contact surface (ContactStage holds it;
-/// O(surface), as the topology is): per surface vertex, ascending in whole id.
+/// O(surface vertices)): per surface vertex, ascending in whole id. whole, owner and body
+/// view the part's tables (Model::Part::surface_node, surface_owner, surface_body) on a
+/// part, the stage's own on a whole model.
 struct SurfaceVertices {
-  std::vector<Index> whole;  ///< its node's whole-model id
-  std::vector<Index> node;   ///< its node in the part, -1 when the part does not hold it
-  std::vector<int> owner;    ///< its volume owner
-  std::vector<int> body;     ///< its node's body
+  std::span<const Index> whole;  ///< its node's whole-model id
+  std::vector<Index> node;       ///< its node in the part, -1 when the part does not hold it
+  std::span<const int> owner;    ///< its volume owner
+  std::span<const int> body;     ///< its node's body
 };
 
 /// Which nodes' states ContactPatch::exchange brings: the owned primitives' (own()), the

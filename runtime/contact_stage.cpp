@@ -100,9 +100,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
             (model_.is_part() ? model_.part.surface_edge : median_edge_length(surface_, mesh.reference));
   have_candidates_ = false;
   pairs_.clear();
-  body_.clear();
+  body_ = {};
   if (!dec_) {
-    if (by_body()) body_ = mesh.node_body;
+    if (by_body()) node_body_ = mesh.node_body, body_ = node_body_;
     vertex_triangles_ = vertex_triangles(surface_);
     return;
   }
@@ -118,6 +118,7 @@ void ContactStage::set_vertices(const Mesh& mesh) {
   // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
   // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
   vertices_ = {};
+  whole_tables_ = {};
   if (model_.is_part()) {
     const Model::Part& part = model_.part;
     vertices_.whole = part.surface_node;
@@ -133,10 +134,13 @@ void ContactStage::set_vertices(const Mesh& mesh) {
       for (Index& n : e) n = at[n];
     std::iota(surface_.vertices.begin(), surface_.vertices.end(), 0);
     for (const Index n : vertices_.node) {
-      vertices_.whole.push_back(model_.whole_node(n));
-      vertices_.owner.push_back(dec_->node_owner(n));
-      vertices_.body.push_back(mesh.node_body[n]);
+      whole_tables_.whole.push_back(model_.whole_node(n));
+      whole_tables_.owner.push_back(dec_->node_owner(n));
+      whole_tables_.body.push_back(mesh.node_body[n]);
     }
+    vertices_.whole = whole_tables_.whole;
+    vertices_.owner = whole_tables_.owner;
+    vertices_.body = whole_tables_.body;
   }
   // excluded() reads the surface's ids: surface vertices here.
   if (by_body()) body_ = vertices_.body;
@@ -240,7 +244,7 @@ NamedSurface ContactStage::first_owned() const {
   // A whole model on ranks (shells, cracks in contact): each primitive by the volume owner
   // of its first node, a triangle named by its place in the surface (t, 0, 0).
   NamedSurface owned;
-  const std::vector<Index>& whole = vertices_.whole;
+  const std::span<const Index> whole = vertices_.whole;
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
     const auto& n = surface_.triangles[t];
     if (vertices_.owner[n[0]] == dec_->rank())
@@ -255,7 +259,7 @@ std::vector<NamedTriangle> ContactStage::home_triangles() const {
   if (model_.is_part()) return shatter::home_triangles(model_, *dec_);
   // A whole model on ranks: named as in first_owned().
   std::vector<NamedTriangle> home;
-  const std::vector<Index>& whole = vertices_.whole;
+  const std::span<const Index> whole = vertices_.whole;
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
     const auto& n = surface_.triangles[t];
     const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
@@ -356,7 +360,8 @@ long ContactStage::whole_surface_bytes() const {
   auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
   return b(surface_.triangles) + b(surface_.body) + b(surface_.edges) + b(surface_.vertices) +
          b(vertex_triangles_.offsets) + b(vertex_triangles_.items) + b(vertex_triangles_.position) +
-         b(vertices_.whole) + b(vertices_.node) + b(vertices_.owner) + b(vertices_.body) + b(body_) + b(twin_of_) +
+         b(whole_tables_.whole) + b(whole_tables_.owner) + b(whole_tables_.body) + b(vertices_.node) +
+         b(node_body_) + b(twin_of_) +
          (patch_ ? patch_->whole_surface_bytes() : 0);
 }
 

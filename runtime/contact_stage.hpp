@@ -200,6 +200,11 @@ class ContactStage {
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
   SurfaceVertices vertices_;          ///< several ranks: what is known of each surface vertex
+  /// A whole model on several ranks: the tables vertices_ views (a part's are in the part).
+  struct {
+    std::vector<Index> whole;
+    std::vector<int> owner, body;
+  } whole_tables_;
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
@@ -210,7 +215,10 @@ class ContactStage {
   bool self_ = true;                            ///< contact.self
   std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free
   bool any_free_rigid_ = false;
-  std::vector<int> body_;  ///< per surface id, its body (with contact.pairs or contact.self: false, or shells)
+  /// Per surface id, its body (with contact.pairs or contact.self: false, or shells): the
+  /// node_body_ copy on one rank, the vertices' bodies on several.
+  std::span<const int> body_;
+  std::vector<int> node_body_;
   std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
   std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells (grows the search boxes: inflated_boxes)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node

@@ -10,13 +10,13 @@ namespace shatter {
 
 namespace {
 
-/// Every boundary triangle of the part's mesh, but those in skip, named, in name order (local
-/// elements ascend in whole id). Faces the part misclassifies (of outer ghosts, whose
+/// Every boundary triangle of the part's mesh, named, in name order (local elements ascend in
+/// whole id). Faces the part misclassifies (of outer ghosts, whose
 /// neighbours it lacks) hold no node of an owned element.
-std::vector<NamedTriangle> part_boundary(const Model& model, std::span<const MeshFace> skip) {
+std::vector<NamedTriangle> part_boundary(const Model& model) {
   const Mesh& mesh = model.mesh;
   std::vector<NamedTriangle> out;
-  for (const auto& [e, f] : boundary_faces(mesh, skip)) {
+  for (const auto& [e, f] : boundary_faces(mesh)) {
     const Index* n = mesh.element(e);
     const auto subs = face_triangles(mesh.order, f);
     for (size_t s = 0; s < subs.size(); ++s)
@@ -29,7 +29,7 @@ std::vector<NamedTriangle> part_boundary(const Model& model, std::span<const Mes
 
 }  // namespace
 
-NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::span<const MeshFace> skip) {
+NamedSurface owned_surface(const Model& model, const Decomposition& dec) {
   // The part's triangles, owned or not: those of ghost elements name the edges' smallest
   // triangles too; the misclassified ones share no edge with an owned triangle.
   struct Seen {
@@ -39,7 +39,7 @@ NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::sp
   };
   NamedSurface out;
   std::vector<Seen> seen;
-  for (const NamedTriangle& t : part_boundary(model, skip)) {
+  for (const NamedTriangle& t : part_boundary(model)) {
     const bool owned = dec.owns_element(model.local_element(t.name[0]));
     if (owned) out.triangles.push_back(t);
     for (int c = 0; c < 3; ++c) {
@@ -54,8 +54,7 @@ NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::sp
   return out;
 }
 
-std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec,
-                                          std::span<const MeshFace> skip) {
+std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec) {
   // A node whose volume owner this rank is is touched here, so its star is held and the
   // faces through it are classified as in the whole mesh.
   const auto home = [&](Index whole) {
@@ -63,7 +62,7 @@ std::vector<NamedTriangle> home_triangles(const Model& model, const Decompositio
     return n >= 0 && (!dec.distributed() || (!dec.node_ranks(n).empty() && dec.node_owner(n) == dec.rank()));
   };
   std::vector<NamedTriangle> out;
-  for (const NamedTriangle& t : part_boundary(model, skip))
+  for (const NamedTriangle& t : part_boundary(model))
     if (home(t.nodes[0]) || home(t.nodes[1]) || home(t.nodes[2])) out.push_back(t);
   return out;
 }

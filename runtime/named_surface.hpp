@@ -14,7 +14,6 @@
 // boundary triangle through an edge of an owned triangle is a face of an element
 // in the star of the edge's nodes.
 #include <array>
-#include <span>
 #include <vector>
 
 #include "contact/surface.hpp"
@@ -40,15 +39,14 @@ struct NamedSurface {
 };
 
 /// This rank's share of the surface of the model's mesh (a part with its first ghost layer,
-/// or a whole model), but the faces in `skip` (local (element, face), ascending).
-NamedSurface owned_surface(const Model& model, const Decomposition& dec, std::span<const MeshFace> skip = {});
+/// or a whole model).
+NamedSurface owned_surface(const Model& model, const Decomposition& dec);
 
 /// The boundary triangles through the nodes whose volume owner this rank is
 /// (Decomposition::node_owner), in name order: around each such node, every triangle of the
 /// whole surface, those whose normals the surface normal there sums (surface_normal). The
 /// owner holds the node's star, so it classifies the faces through the node as the whole
 /// mesh does.
-std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec,
-                                          std::span<const MeshFace> skip = {});
+std::vector<NamedTriangle> home_triangles(const Model& model, const Decomposition& dec);
 
 }  // namespace shatter
