@@ -239,32 +239,31 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   exchange(x_old, x_new, v, PatchPlan::Active);
 }
 
+NamedTriangle ContactStage::named_triangle(Index t) const {
+  const auto& n = surface_.triangles[t];
+  const std::span<const Index> whole = vertices_.whole;
+  return {{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]};
+}
+
 NamedSurface ContactStage::first_owned() const {
   if (model_.is_part()) return owned_surface(model_, *dec_);
   // A whole model on ranks (shells, cracks in contact): each primitive by the volume owner
-  // of its first node, a triangle named by its place in the surface (t, 0, 0).
+  // of its first node.
   NamedSurface owned;
-  const std::span<const Index> whole = vertices_.whole;
-  for (Index t = 0; t < surface_.num_triangles(); ++t) {
-    const auto& n = surface_.triangles[t];
-    if (vertices_.owner[n[0]] == dec_->rank())
-      owned.triangles.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
-  }
+  for (Index t = 0; t < surface_.num_triangles(); ++t)
+    if (vertices_.owner[surface_.triangles[t][0]] == dec_->rank()) owned.triangles.push_back(named_triangle(t));
   for (const auto& [a, b] : surface_.edges)
-    if (vertices_.owner[a] == dec_->rank()) owned.edges.push_back({whole[a], whole[b]});
+    if (vertices_.owner[a] == dec_->rank()) owned.edges.push_back({vertices_.whole[a], vertices_.whole[b]});
   return owned;
 }
 
 std::vector<NamedTriangle> ContactStage::home_triangles() const {
   if (model_.is_part()) return shatter::home_triangles(model_, *dec_);
-  // A whole model on ranks: named as in first_owned().
   std::vector<NamedTriangle> home;
-  const std::span<const Index> whole = vertices_.whole;
+  const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
     const auto& n = surface_.triangles[t];
-    const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
-    if (mine(n[0]) || mine(n[1]) || mine(n[2]))
-      home.push_back({{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]});
+    if (mine(n[0]) || mine(n[1]) || mine(n[2])) home.push_back(named_triangle(t));
   }
   return home;
 }

@@ -175,6 +175,8 @@ class ContactStage {
   /// On several ranks: the first (canonical order) of every rank's `mine` (patch ids), in
   /// whole ids, named in unresolved_ (collective).
   std::optional<ContactPair> first_unresolved(const std::optional<ContactPair>& mine);
+  /// Triangle t of a whole model's surface (on several ranks), named by its place: (t, 0, 0).
+  NamedTriangle named_triangle(Index t) const;
   /// The primitives owned here before the first partition: on a part, those it names
   /// (owned_surface: a triangle by its element's owner, an edge by its smallest-named
   /// triangle's); on a whole model, each by the volume owner of its first node.
