@@ -320,12 +320,12 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
 }
 
 Index ContactPatch::ring_triangle(const NamedTriangle& t) {
-  const auto [it, fresh] = ring_name_.try_emplace(t.name, ring_.num_triangles());
+  const std::int64_t key = name_key(t.name);
+  const auto [it, fresh] = ring_name_.try_emplace(key, ring_.num_triangles());
   if (fresh) {
     ring_.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
     ring_.body.push_back(t.body);
-    // The name (element, face 0-3, sub-triangle 0-3) as one number of the same order.
-    ring_keys_.push_back(16 * static_cast<std::int64_t>(t.name[0]) + 4 * t.name[1] + t.name[2]);
+    ring_keys_.push_back(key);
   }
   return it->second;
 }
@@ -338,8 +338,8 @@ std::span<const Index> ContactPatch::ring_of(Index v) const {
 
 void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   // Each vertex's volume owner holds every triangle around it (home_triangles). Asked for a
-  // list of vertices, it answers with the triangles around them, each once (kind-free: 7
-  // numbers, name, nodes, body), in name order.
+  // list of vertices, it answers with the triangles around them, each once (append_words),
+  // in name order.
   const int ranks = dec_.size(), me = dec_.rank();
   std::vector<std::vector<Index>> ask(ranks);
   std::vector<Index> mine;
@@ -359,12 +359,7 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
     std::vector<Index> triangles;
     for (const Index whole : asked[r]) around_home(whole, triangles);
     sort_unique(triangles);
-    for (const Index t : triangles) {
-      const NamedTriangle& tri = home_[t];
-      reply[r].insert(reply[r].end(), tri.name.begin(), tri.name.end());
-      reply[r].insert(reply[r].end(), tri.nodes.begin(), tri.nodes.end());
-      reply[r].push_back(tri.body);
-    }
+    for (const Index t : triangles) append_words(home_[t], reply[r]);
   }
   const std::vector<std::vector<Index>> answers = dec_.alltoall(reply);
   // Each ring is appended whole to ring_items_ (one array: the rings are read together at
@@ -384,9 +379,8 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   for (int r = 0; r < ranks; ++r) {
     std::vector<std::vector<Index>> rings(ask[r].size());
     const std::vector<Index>& list = answers[r];
-    for (size_t i = 0; i + 7 <= list.size(); i += 7) {
-      const NamedTriangle t{{list[i], list[i + 1], list[i + 2]}, {list[i + 3], list[i + 4], list[i + 5]},
-                            static_cast<int>(list[i + 6])};
+    for (size_t i = 0; i + kNamedTriangleWords <= list.size(); i += kNamedTriangleWords) {
+      const NamedTriangle t = read_words(&list[i]);
       const Index at = ring_triangle(t);
       for (const Index whole : t.nodes)
         if (const auto it = std::lower_bound(ask[r].begin(), ask[r].end(), whole); it != ask[r].end() && *it == whole)

@@ -212,9 +212,9 @@ class ContactPatch {
   std::vector<NamedTriangle> home_;           ///< around the vertices whose volume owner this rank is
   std::vector<std::pair<Index, Index>> home_at_;  ///< (whole node, home_ index), ascending
   ContactSurface ring_;                       ///< every triangle fetched, once (triangles and bodies; surface vertex ids)
-  std::vector<std::int64_t> ring_keys_;  ///< per triangle of ring_: its name as one number, in name order
+  std::vector<std::int64_t> ring_keys_;  ///< per triangle of ring_: its name_key
   std::vector<std::uint8_t> ring_mark_;  ///< per triangle of ring_: scratch of activate(), 0 between calls
-  std::map<std::array<Index, 3>, Index> ring_name_;  ///< ring_'s index of a triangle's name
+  std::map<std::int64_t, Index> ring_name_;  ///< ring_'s index of a triangle's name_key
   std::vector<Index> ring_at_;  ///< per surface vertex: its ring (k: ring_offsets_[k]), -1 before it is fetched
   std::vector<Index> ring_offsets_{0}, ring_items_;  ///< the rings fetched, CSR: ring_ indices, name order
   PlanLists lists_[3];              ///< per PatchPlan

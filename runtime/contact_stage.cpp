@@ -289,16 +289,19 @@ void ContactStage::partition() {
   }
   for (const float w : weight_) weights.insert(weights.end(), {1.0f, 0.01f + w});
   const std::vector<int> to = partition_->partition(names, points, weights);
-  // The primitives that leave go to their new ranks with their data (a triangle: kind, name,
-  // nodes, body; an edge: kind, nodes).
+  // The primitives that leave go to their new ranks with their data (a triangle: kind 0, then
+  // its words, append_words; an edge: kind 1, its nodes).
   const int me = dec_->rank();
   NamedSurface kept;
   std::vector<std::vector<Index>> out(dec_->size());
   for (size_t k = 0; k < nt; ++k) {
     const NamedTriangle& t = owned_.triangles[k];
-    if (to[k] == me) kept.triangles.push_back(t);
-    else
-      out[to[k]].insert(out[to[k]].end(), {0, t.name[0], t.name[1], t.name[2], t.nodes[0], t.nodes[1], t.nodes[2], t.body});
+    if (to[k] == me) {
+      kept.triangles.push_back(t);
+    } else {
+      out[to[k]].push_back(0);
+      append_words(t, out[to[k]]);
+    }
   }
   for (size_t k = 0; k < ne; ++k) {
     if (to[nt + k] == me) kept.edges.push_back(owned_.edges[k]);
@@ -307,9 +310,8 @@ void ContactStage::partition() {
   for (const auto& list : dec_->alltoall(out))
     for (size_t i = 0; i < list.size();)
       if (list[i] == 0) {
-        kept.triangles.push_back({{list[i + 1], list[i + 2], list[i + 3]}, {list[i + 4], list[i + 5], list[i + 6]},
-                                  static_cast<int>(list[i + 7])});
-        i += 8;
+        kept.triangles.push_back(read_words(&list[i + 1]));
+        i += 1 + kNamedTriangleWords;
       } else {
         kept.edges.push_back({list[i + 1], list[i + 2]});
         i += 3;

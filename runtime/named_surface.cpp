@@ -29,6 +29,16 @@ std::vector<NamedTriangle> part_boundary(const Model& model) {
 
 }  // namespace
 
+void append_words(const NamedTriangle& t, std::vector<Index>& out) {
+  out.insert(out.end(), t.name.begin(), t.name.end());
+  out.insert(out.end(), t.nodes.begin(), t.nodes.end());
+  out.push_back(t.body);
+}
+
+NamedTriangle read_words(const Index* w) {
+  return {{w[0], w[1], w[2]}, {w[3], w[4], w[5]}, static_cast<int>(w[6])};
+}
+
 NamedSurface owned_surface(const Model& model, const Decomposition& dec) {
   // The part's triangles, owned or not: those of ghost elements name the edges' smallest
   // triangles too; the misclassified ones share no edge with an owned triangle.

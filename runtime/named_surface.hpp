@@ -14,6 +14,8 @@
 // boundary triangle through an edge of an owned triangle is a face of an element
 // in the star of the edge's nodes.
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "contact/surface.hpp"
@@ -31,6 +33,17 @@ struct NamedTriangle {
   int body = 0;                ///< the element's body
   friend bool operator==(const NamedTriangle&, const NamedTriangle&) = default;
 };
+
+/// A triangle's name as one number of the same order (faces and sub-triangles are 0-3).
+inline std::int64_t name_key(const std::array<Index, 3>& name) {
+  return 16 * static_cast<std::int64_t>(name[0]) + 4 * name[1] + name[2];
+}
+
+/// A triangle in a message: kNamedTriangleWords numbers (name, nodes, body), appended to `out`
+/// by append_words and read back by read_words from its first.
+inline constexpr std::size_t kNamedTriangleWords = 7;
+void append_words(const NamedTriangle& t, std::vector<Index>& out);
+NamedTriangle read_words(const Index* words);
 
 /// A rank's share of the contact surface's primitives.
 struct NamedSurface {

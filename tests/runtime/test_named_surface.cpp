@@ -46,20 +46,15 @@ void check_order(int order) {
     ASSERT_GE(e, 0);
     EXPECT_TRUE(dec.owns_element(e)) << "triangle of element " << t.name[0] << " named by a rank not owning it";
   }
-  // Every rank's lists on every rank: a triangle as 7 numbers (name, nodes, body).
+  // Every rank's lists on every rank: a triangle as its words (append_words).
   std::vector<Index> flat, edges;
-  for (const NamedTriangle& t : mine.triangles) {
-    flat.insert(flat.end(), t.name.begin(), t.name.end());
-    flat.insert(flat.end(), t.nodes.begin(), t.nodes.end());
-    flat.push_back(t.body);
-  }
+  for (const NamedTriangle& t : mine.triangles) append_words(t, flat);
   for (const auto& e : mine.edges) edges.insert(edges.end(), e.begin(), e.end());
   flat = dec.allgather(flat);
   edges = dec.allgather(edges);
   std::vector<NamedTriangle> all;
-  for (size_t k = 0; k + 7 <= flat.size(); k += 7)
-    all.push_back({{flat[k], flat[k + 1], flat[k + 2]}, {flat[k + 3], flat[k + 4], flat[k + 5]},
-                   static_cast<int>(flat[k + 6])});
+  for (size_t k = 0; k + kNamedTriangleWords <= flat.size(); k += kNamedTriangleWords)
+    all.push_back(read_words(&flat[k]));
   std::sort(all.begin(), all.end(), [](const NamedTriangle& a, const NamedTriangle& b) { return a.name < b.name; });
   std::vector<std::array<Index, 2>> all_edges;
   for (size_t k = 0; k + 2 <= edges.size(); k += 2) all_edges.push_back({edges[k], edges[k + 1]});
