@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <map>
+#include <numeric>
 
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
@@ -20,7 +21,7 @@ void add_nodes(std::span<const std::array<Index, K>> primitives, std::vector<Ind
   for (const auto& p : primitives) nodes.insert(nodes.end(), p.begin(), p.end());
 }
 
-/// Edge {a, b} (surface vertex ids) as one number whose order is that of (a, b).
+/// Edge {a, b} (whole ids) as one number whose order is that of (a, b).
 std::uint64_t edge_key(Index a, Index b) {
   return static_cast<std::uint64_t>(a) << 32 | static_cast<std::uint32_t>(b);
 }
@@ -53,49 +54,50 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 
 ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
                            const Model& model, Index num_nodes, std::span<const double> node_reach)
-    : dec_(dec), vertices_(vertices), model_(model), num_nodes_(num_nodes), part_reach_(node_reach),
-      home_(std::move(home)) {
+    : dec_(dec), model_(model), num_nodes_(num_nodes), part_reach_(node_reach), home_(std::move(home)) {
   for (size_t t = 0; t < home_.size(); ++t)
     for (const Index n : home_[t].nodes) home_at_.emplace_back(n, static_cast<Index>(t));
   std::sort(home_at_.begin(), home_at_.end());
-  const auto nv = static_cast<Index>(vertices.whole.size());
-  ring_at_.assign(nv, -1);
-  for (Index k = 0; k < nv; ++k) {
+  for (size_t k = 0; k < vertices.whole.size(); ++k) {
     // The part's rows the time loop keeps: those of its elements' nodes, and every node of a
     // rigid body (RigidBodies places them all on every rank, after DCR too).
     const Index n = vertices.node[k];
-    const std::span<const int> ranks = n < 0 ? std::span<const int>() : dec.node_ranks(n);
+    SHATTER_ASSERT(n >= 0);
+    const std::span<const int> ranks = dec.node_ranks(n);
     const bool touches = std::binary_search(ranks.begin(), ranks.end(), dec.rank());
     const bool rigid = model.scene.bodies[vertices.body[k]].has_rigid_state();
-    SHATTER_ASSERT(n >= 0 || !rigid);
-    if (touches || rigid) kept_.push_back(k);
+    if (touches || rigid) kept_.push_back(know(vertices.whole[k], vertices.owner[k], vertices.body[k]));
     if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
     if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n);
   }
   sort_unique(touching_);
-  position_.assign(nv, -1);
   renumber(kept_);
 }
 
 ContactPatch::~ContactPatch() = default;
 
-Index ContactPatch::vertex(Index whole) const {
-  const std::span<const Index> ids = vertices_.whole;
-  const auto it = std::lower_bound(ids.begin(), ids.end(), whole);
-  SHATTER_ASSERT(it != ids.end() && *it == whole);
-  return static_cast<Index>(it - ids.begin());
+Index ContactPatch::know(Index whole, int owner, int body) {
+  const auto [it, fresh] = known_at_.try_emplace(whole, static_cast<Index>(known_.size()));
+  if (fresh) known_.push_back({whole, model_.local_node(whole), owner, body});
+  return it->second;
+}
+
+Index ContactPatch::known(Index whole) const {
+  const auto it = known_at_.find(whole);
+  SHATTER_ASSERT(it != known_at_.end());
+  return it->second;
 }
 
 Index ContactPatch::node(Index whole) const {
-  const Index k = position_[vertex(whole)];
+  const Index k = known_[known(whole)].position;
   SHATTER_ASSERT(k >= 0);
   return k;
 }
 
-long ContactPatch::whole_surface_bytes() const {
-  return static_cast<long>((position_.capacity() + ring_at_.capacity()) * sizeof(Index) + node_mark_.capacity());
+void ContactPatch::sort_by_whole(std::vector<Index>& nodes) const {
+  std::sort(nodes.begin(), nodes.end(), [&](Index a, Index b) { return known_[a].whole < known_[b].whole; });
 }
 
 Index ContactPatch::owned_primitive(Index q) const {
@@ -119,68 +121,97 @@ void relabel(ContactSurface& surface, std::span<const Index> map) {
 }  // namespace
 
 void ContactPatch::renumber(std::vector<Index> nodes) {
-  // Both numberings ascend with the part's (and the whole model's) ids, so the surfaces'
-  // orders (edges a < b, vertices ascending) stay as they are.
+  // The patch numbering ascends with the whole model's ids, so the surfaces' orders (edges
+  // a < b, vertices ascending) are those of the whole ids.
   std::vector<Vec3> x_old(nodes.size()), x_new(nodes.size()), v(nodes.size());
   std::vector<double> inv_mass(nodes.size(), 0.0);
   std::vector<std::uint8_t> held(held_.empty() ? 0 : nodes.size(), 0);
   for (size_t k = 0; k < nodes.size(); ++k)
-    if (const Index was = position_[nodes[k]]; was >= 0) {
+    if (const Index was = known_[nodes[k]].position; was >= 0) {
       x_old[k] = x_old_[was], x_new[k] = x_new_[was], v[k] = v_[was], inv_mass[k] = inv_mass_[was];
       if (!held.empty()) held[k] = held_[was];
     }
-  for (const Index n : nodes_) position_[n] = -1;
-  for (size_t k = 0; k < nodes.size(); ++k) position_[nodes[k]] = static_cast<Index>(k);
+  for (const Index n : nodes_) known_[n].position = -1;
+  for (size_t k = 0; k < nodes.size(); ++k) known_[nodes[k]].position = static_cast<Index>(k);
   std::vector<Index> map(nodes_.size());
-  for (size_t k = 0; k < nodes_.size(); ++k) map[k] = position_[nodes_[k]];
+  for (size_t k = 0; k < nodes_.size(); ++k) map[k] = known_[nodes_[k]].position;
   relabel(owned_, map);
   nodes_ = std::move(nodes);
   x_old_ = std::move(x_old), x_new_ = std::move(x_new), v_ = std::move(v);
   inv_mass_ = std::move(inv_mass), held_ = std::move(held);
   reach_.clear();
   if (!part_reach_.empty())
-    for (const Index n : nodes_) reach_.push_back(part_reach_[vertices_.node[n]]);
+    for (const Index n : nodes_) reach_.push_back(part_reach_[known_[n].node]);
   kept_at_.clear();
-  for (const Index n : kept_) kept_at_.push_back(position_[n]);
+  for (const Index n : kept_) kept_at_.push_back(known_[n].position);
   for (int p = 0; p < 3; ++p)
     if (plans_[p]) plans_[p] = halo_of(lists_[p]);
 }
 
+void ContactPatch::forget() {
+  // The patch's nodes keep their places (known id k: patch node k); the rings go.
+  std::vector<KnownVertex> known;
+  known_at_.clear();
+  for (size_t k = 0; k < nodes_.size(); ++k) {
+    known.push_back(known_[nodes_[k]]);
+    known.back().ring = -1;
+    known_at_.emplace(known.back().whole, static_cast<Index>(k));
+  }
+  std::vector<Index> map(known_.size(), -1);
+  for (size_t k = 0; k < nodes_.size(); ++k) map[nodes_[k]] = static_cast<Index>(k);
+  for (Index& n : kept_) n = map[n];
+  std::iota(nodes_.begin(), nodes_.end(), 0);
+  known_ = std::move(known);
+  ring_ = {}, ring_keys_.clear(), ring_mark_.clear(), ring_name_.clear();
+  ring_offsets_.assign(1, 0), ring_items_.clear();
+}
+
 void ContactPatch::own(const NamedSurface& primitives) {
   owned_once_ = true;
+  for (int p = 0; p < 3; ++p) plans_[p].reset(), lists_[p] = {};
+  owned_ = {}, patch_ = {}, normals_ = {}, normals_around_ = {};
+  renumber(kept_);
+  forget();
   ContactSurface owned;
   for (const NamedTriangle& t : primitives.triangles) {
-    owned.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    std::array<Index, 3> k;
+    for (int c = 0; c < 3; ++c) k[c] = know(t.nodes[c], t.owner[c], t.body);
+    owned.triangles.push_back(k);
     owned.body.push_back(t.body);
   }
-  for (const auto& [a, b] : primitives.edges) owned.edges.push_back({vertex(a), vertex(b)});
-  SHATTER_REQUIRE(std::is_sorted(owned.edges.begin(), owned.edges.end()) &&
-                      std::adjacent_find(owned.edges.begin(), owned.edges.end()) == owned.edges.end(),
+  owned_edge_keys_.clear();
+  for (const NamedEdge& e : primitives.edges) {
+    owned.edges.push_back({know(e.nodes[0], e.owner[0], e.body), know(e.nodes[1], e.owner[1], e.body)});
+    owned_edge_keys_.push_back(edge_key(e.nodes[0], e.nodes[1]));
+  }
+  SHATTER_REQUIRE(std::is_sorted(owned_edge_keys_.begin(), owned_edge_keys_.end()) &&
+                      std::adjacent_find(owned_edge_keys_.begin(), owned_edge_keys_.end()) == owned_edge_keys_.end(),
                   "ContactPatch: owned edges not ascending");
-  owned_edges_ = owned.edges;
   add_nodes<3>(owned.triangles, owned.vertices);
   add_nodes<2>(owned.edges, owned.vertices);
   sort_unique(owned.vertices);
-  for (int p = 0; p < 3; ++p) plans_[p].reset(), lists_[p] = {};
-  owned_ = {}, patch_ = {}, normals_ = {}, normals_around_ = {};
+  sort_by_whole(owned.vertices);
   std::vector<Index> nodes = kept_;
   nodes.insert(nodes.end(), owned.vertices.begin(), owned.vertices.end());
   sort_unique(nodes);
+  sort_by_whole(nodes);
   renumber(std::move(nodes));
   auto& lists = lists_[static_cast<int>(PatchPlan::Owned)];
   lists = plan(owned.vertices, false);
-  relabel(owned, position_);
+  std::vector<Index> position(known_.size());
+  for (size_t k = 0; k < known_.size(); ++k) position[k] = known_[k].position;
+  relabel(owned, position);
   owned_ = std::move(owned);
   plans_[static_cast<int>(PatchPlan::Owned)] = halo_of(lists);
 }
 
 void ContactPatch::add_node(Index n, std::vector<Index>& nodes) {
-  if (!node_mark_[n]) node_mark_[n] = 1, nodes.push_back(n);
+  if (!known_[n].mark) known_[n].mark = true, nodes.push_back(n);
 }
 
 void ContactPatch::sort_marked(std::vector<Index>& nodes) {
-  for (const Index n : nodes) node_mark_[n] = 0;
-  std::sort(nodes.begin(), nodes.end());
+  for (const Index n : nodes) known_[n].mark = false;
+  sort_by_whole(nodes);
 }
 
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
@@ -200,44 +231,57 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (int r = 0; r < ranks; ++r)
     boxes[r] = {Vec3(reach[6 * r], reach[6 * r + 1], reach[6 * r + 2]),
                 Vec3(reach[6 * r + 3], reach[6 * r + 4], reach[6 * r + 5])};
-  // Edges as their nodes' whole ids {a, b}, vertices as -(whole id + 1).
+  // Edges as their words (append_words: whole ids, owners, body), vertices as -(whole id +
+  // 1) and their body (their owner is the sender).
   std::vector<std::vector<Index>> to(ranks);
   for (size_t k = 0; k < owned_.edges.size(); ++k)
     for (int r = 0; r < ranks; ++r)
-      if (r != me && boxes_overlap(own.edges[k], boxes[r]))
-        for (const Index n : owned_.edges[k]) to[r].push_back(whole(n));
+      if (r != me && boxes_overlap(own.edges[k], boxes[r])) {
+        const auto& [a, b] = owned_.edges[k];
+        append_words(NamedEdge{{whole(a), whole(b)}, {owner(a), owner(b)}, body(a)}, to[r]);
+      }
   for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
     for (int r = 0; r < ranks; ++r)
-      if (boxes_overlap(home.vertices[k], boxes[r]))
-        to[r].push_back(-(model_.whole_node(volume_vertices_.vertices[k]) + 1));
-  // The ghost edges as a << 32 | b (surface vertex ids; a 64-bit sort), then the patch's
-  // edges: the owned ones (ascending) and the ghosts merged, each with its owned edge.
-  std::vector<std::uint64_t> ghosts;
+      if (boxes_overlap(home.vertices[k], boxes[r])) {
+        const Index n = volume_vertices_.vertices[k];
+        to[r].insert(to[r].end(), {-(model_.whole_node(n) + 1), model_.mesh.node_body[n]});
+      }
+  // The ghost edges sorted by their whole ids, then the patch's edges: the owned ones
+  // (ascending) and the ghosts merged, each with its owned edge.
+  std::vector<std::pair<std::uint64_t, std::array<Index, 2>>> ghosts;
   std::vector<Index> vertices;
-  for (const auto& list : dec_.alltoall(to))
-    for (size_t at = 0; at < list.size(); ++at)
-      if (list[at] < 0) vertices.push_back(vertex(-list[at] - 1));
-      else ghosts.push_back(edge_key(vertex(list[at]), vertex(list[at + 1]))), ++at;
-  sort_unique(ghosts);
+  const std::vector<std::vector<Index>> received = dec_.alltoall(to);
+  for (int r = 0; r < ranks; ++r)
+    for (size_t at = 0; at < received[r].size();)
+      if (const Index* w = &received[r][at]; w[0] < 0) {
+        vertices.push_back(know(-w[0] - 1, r, static_cast<int>(w[1])));
+        at += 2;
+      } else {
+        const NamedEdge e = read_edge(w);
+        ghosts.push_back({edge_key(e.nodes[0], e.nodes[1]),
+                          {know(e.nodes[0], e.owner[0], e.body), know(e.nodes[1], e.owner[1], e.body)}});
+        at += kNamedEdgeWords;
+      }
+  std::sort(ghosts.begin(), ghosts.end());
+  ghosts.erase(std::unique(ghosts.begin(), ghosts.end()), ghosts.end());
   sort_unique(vertices);
   std::vector<std::array<Index, 2>> edges;
   patch_edge_owned_at_.clear();
   patch_edge_owned_.clear();
-  for (size_t i = 0, j = 0; i < owned_edges_.size() || j < ghosts.size();) {
-    if (j == ghosts.size() || (i < owned_edges_.size() && edge_key(owned_edges_[i][0], owned_edges_[i][1]) < ghosts[j])) {
-      edges.push_back(owned_edges_[i]);
+  const size_t no = owned_edge_keys_.size();
+  for (size_t i = 0, j = 0; i < no || j < ghosts.size();) {
+    if (j == ghosts.size() || (i < no && owned_edge_keys_[i] < ghosts[j].first)) {
+      edges.push_back({nodes_[owned_.edges[i][0]], nodes_[owned_.edges[i][1]]});
       patch_edge_owned_at_.push_back(static_cast<Index>(i++));
     } else {
-      edges.push_back({static_cast<Index>(ghosts[j] >> 32), static_cast<Index>(ghosts[j] & 0xffffffffu)});
+      edges.push_back(ghosts[j++].second);
       patch_edge_owned_at_.push_back(-1);
-      ++j;
     }
     patch_edge_owned_.push_back(patch_edge_owned_at_.back() >= 0 ? 1 : 0);
   }
   // The patch's nodes (made unique by marks: sorting the list with its repeats, each node
   // ~7 times, took a third of reach()'s CPU time on the 76 cubes), then those of the
   // triangles around them, whose normals orient their pairs (activate()).
-  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed;
   for (const auto& t : owned_.triangles)
     for (const Index n : t) add_node(nodes_[n], needed);
@@ -250,9 +294,9 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (size_t k = 0, count = needed.size(); k < count; ++k)
     for (const Index t : ring_of(needed[k]))
       for (const Index n : ring_.triangles[t]) add_node(n, nodes);
-  for (const Index n : nodes) node_mark_[n] = 0;
-  std::sort(needed.begin(), needed.end());
-  std::sort(nodes.begin(), nodes.end());
+  for (const Index n : nodes) known_[n].mark = false;
+  sort_by_whole(needed);
+  sort_by_whole(nodes);
   for (const PatchPlan p : {PatchPlan::Patch, PatchPlan::Active})
     plans_[static_cast<int>(p)].reset(), lists_[static_cast<int>(p)] = {};
   normals_ = {}, normals_around_ = {};
@@ -260,8 +304,9 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   patch_ = {};
   patch_.triangles = owned_.triangles;
   patch_.body = owned_.body;
-  for (const auto& [a, b] : edges) patch_.edges.push_back({position_[a], position_[b]});
-  for (const Index n : vertices) patch_.vertices.push_back(position_[n]);
+  for (const auto& [a, b] : edges) patch_.edges.push_back({known_[a].position, known_[b].position});
+  for (const Index n : vertices) patch_.vertices.push_back(known_[n].position);
+  std::sort(patch_.vertices.begin(), patch_.vertices.end());
   auto& lists = lists_[static_cast<int>(PatchPlan::Patch)];
   lists = plan(needed, false);
   plans_[static_cast<int>(PatchPlan::Patch)] = halo_of(lists);
@@ -287,7 +332,6 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
   // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'); surface
   // vertex ids.
-  node_mark_.resize(vertices_.whole.size(), 0);
   std::vector<Index> needed, triangles;
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) add_node(nodes_[k], needed);
@@ -306,7 +350,7 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   std::vector<char> vertex_mark(nodes_.size(), 0);
   for (const Index t : triangles) {
     const auto& [a, b, c] = ring_.triangles[t];
-    normals_.triangles.push_back({position_[a], position_[b], position_[c]});
+    normals_.triangles.push_back({known_[a].position, known_[b].position, known_[c].position});
     normals_.body.push_back(ring_.body[t]);
     for (const Index n : normals_.triangles.back()) vertex_mark[n] = 1;
   }
@@ -323,7 +367,8 @@ Index ContactPatch::ring_triangle(const NamedTriangle& t) {
   const std::int64_t key = name_key(t.name);
   const auto [it, fresh] = ring_name_.try_emplace(key, ring_.num_triangles());
   if (fresh) {
-    ring_.triangles.push_back({vertex(t.nodes[0]), vertex(t.nodes[1]), vertex(t.nodes[2])});
+    ring_.triangles.push_back({know(t.nodes[0], t.owner[0], t.body), know(t.nodes[1], t.owner[1], t.body),
+                               know(t.nodes[2], t.owner[2], t.body)});
     ring_.body.push_back(t.body);
     ring_keys_.push_back(key);
   }
@@ -331,8 +376,8 @@ Index ContactPatch::ring_triangle(const NamedTriangle& t) {
 }
 
 std::span<const Index> ContactPatch::ring_of(Index v) const {
-  SHATTER_ASSERT(ring_at_[v] >= 0);
-  const Index k = ring_at_[v];
+  const Index k = known_[v].ring;
+  SHATTER_ASSERT(k >= 0);
   return {ring_items_.data() + ring_offsets_[k], static_cast<size_t>(ring_offsets_[k + 1] - ring_offsets_[k])};
 }
 
@@ -344,9 +389,9 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   std::vector<std::vector<Index>> ask(ranks);
   std::vector<Index> mine;
   for (const Index v : vertices)
-    if (ring_at_[v] < 0) {
-      if (vertices_.owner[v] == me) mine.push_back(v);
-      else ask[vertices_.owner[v]].push_back(vertices_.whole[v]);
+    if (known_[v].ring < 0) {
+      if (known_[v].owner == me) mine.push_back(v);
+      else ask[known_[v].owner].push_back(known_[v].whole);
     }
   for (std::vector<Index>& list : ask) std::sort(list.begin(), list.end());
   const auto around_home = [&](Index whole, std::vector<Index>& out) {
@@ -365,13 +410,13 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   // Each ring is appended whole to ring_items_ (one array: the rings are read together at
   // every search).
   const auto append = [&](Index v, const std::vector<Index>& ring) {
-    ring_at_[v] = static_cast<Index>(ring_offsets_.size() - 1);
+    known_[v].ring = static_cast<Index>(ring_offsets_.size() - 1);
     ring_items_.insert(ring_items_.end(), ring.begin(), ring.end());
     ring_offsets_.push_back(static_cast<Index>(ring_items_.size()));
   };
   for (const Index v : mine) {
     std::vector<Index> triangles, ring;
-    around_home(vertices_.whole[v], triangles);
+    around_home(known_[v].whole, triangles);
     for (const Index t : triangles) ring.push_back(ring_triangle(home_[t]));
     append(v, ring);
   }
@@ -380,13 +425,13 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
     std::vector<std::vector<Index>> rings(ask[r].size());
     const std::vector<Index>& list = answers[r];
     for (size_t i = 0; i + kNamedTriangleWords <= list.size(); i += kNamedTriangleWords) {
-      const NamedTriangle t = read_words(&list[i]);
+      const NamedTriangle t = read_triangle(&list[i]);
       const Index at = ring_triangle(t);
       for (const Index whole : t.nodes)
         if (const auto it = std::lower_bound(ask[r].begin(), ask[r].end(), whole); it != ask[r].end() && *it == whole)
           rings[it - ask[r].begin()].push_back(at);
     }
-    for (size_t k = 0; k < ask[r].size(); ++k) append(vertex(ask[r][k]), rings[k]);
+    for (size_t k = 0; k < ask[r].size(); ++k) append(known(ask[r][k]), rings[k]);
   }
 }
 
@@ -395,10 +440,10 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
   PlanLists lists;
   std::vector<std::vector<Index>> requests(ranks);
   for (const Index n : nodes) {
-    const int owner = vertices_.owner[n];
+    const int owner = known_[n].owner;
     if (owner == me) continue;
     lists.receive[owner].push_back(n);
-    requests[owner].push_back(vertices_.whole[n]);
+    requests[owner].push_back(known_[n].whole);
   }
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
@@ -414,7 +459,7 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
 std::unique_ptr<Halo> ContactPatch::halo_of(const PlanLists& lists) const {
   std::map<int, std::vector<Index>> receive;
   for (const auto& [r, list] : lists.receive)
-    for (const Index n : list) receive[r].push_back(position_[n]);
+    for (const Index n : list) receive[r].push_back(known_[n].position);
   return std::make_unique<Halo>(num_nodes_, num_nodes(), exchange_from(lists.send), exchange_from(receive),
                                 dec_.comm(), kPatchTag);
 }
@@ -449,7 +494,7 @@ void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new
   if (!held.empty()) held_.resize(nodes_.size(), 0);
   x_old_ = x_new_;
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = vertices_.node[kept_[i]], k = kept_at_[i];
+    const Index n = known_[kept_[i]].node, k = kept_at_[i];
     x_old_[k] = x_old[n], x_new_[k] = x_new[n], v_[k] = v[n], inv_mass_[k] = inv_mass[n];
     if (!held.empty()) held_[k] = held[n];
   }
@@ -457,7 +502,7 @@ void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new
 
 void ContactPatch::store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const {
   for (size_t i = 0; i < kept_.size(); ++i) {
-    const Index n = vertices_.node[kept_[i]], k = kept_at_[i];
+    const Index n = known_[kept_[i]].node, k = kept_at_[i];
     x_old[n] = x_old_[k], x_new[n] = x_new_[k], v[n] = v_[k];
   }
 }
@@ -485,7 +530,7 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
   if (with_data)
     for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].receive)
       for (const Index n : list) {
-        const Index k = position_[n];
+        const Index k = known_[n].position;
         inv_mass_[k] = data[k].x();
         if (!held_.empty()) held_[k] = static_cast<std::uint8_t>(data[k].y());
       }

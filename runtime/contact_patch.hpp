@@ -12,14 +12,16 @@
 // The patch numbers its nodes itself and holds their states in arrays of its
 // own (docs/parallel.md "Patches with their own topology", step 3): the search
 // and DCR read the part's arrays only for the surface nodes of the part's
-// elements. The surface's topology (triangles, edges, the vertex -> triangle
-// lists) is still held on every rank: memory that grows with the surface, no
-// traffic. Between ranks, nodes are named by their whole-model ids and edges by
-// their two nodes' (step 1), never by positions in the replicated surface.
+// elements. It knows only the vertices it has met (its primitives', ghosts' and
+// rings', and the part's kept surface nodes), each with its whole id, volume
+// owner and body, which come with the named primitives: no array of the patch is
+// sized by the whole surface (step 2, the end). Between ranks, nodes are named by
+// their whole-model ids and edges by their two nodes' (step 1).
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "contact/candidates.hpp"
@@ -41,13 +43,13 @@ struct Model;
 SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x_old, std::span<const Vec3> x_new,
                           double margin, std::span<const double> reach = {});
 
-/// What every rank knows of each vertex of the contact surface (ContactStage holds it;
-/// O(surface vertices)): per surface vertex, ascending in whole id. whole, owner and body
-/// view the part's tables (Model::Part::surface_node, surface_owner, surface_body) on a
-/// part, the stage's own on a whole model.
+/// What a rank knows of the contact surface's vertices it holds (ContactStage holds it): per
+/// vertex, ascending in whole id. whole, owner and body view the part's tables
+/// (Model::Part::surface_node, surface_owner, surface_body: the surface vertices the part
+/// holds) on a part, the stage's own on a whole model (every vertex).
 struct SurfaceVertices {
   std::span<const Index> whole;  ///< its node's whole-model id
-  std::vector<Index> node;       ///< its node in the part, -1 when the part does not hold it
+  std::vector<Index> node;       ///< its node in the part
   std::span<const int> owner;    ///< its volume owner
   std::span<const int> body;     ///< its node's body
 };
@@ -58,12 +60,11 @@ enum class PatchPlan { Owned, Patch, Active };
 
 class ContactPatch {
  public:
-  /// vertices: what is known of each vertex of the contact surface (vertex k: the surface's
-  /// k-th node, ascending in whole id), held by the caller for the patch's lifetime (a new
-  /// surface needs a new patch); home: the surface's triangles around the vertices whose
-  /// volume owner this rank is (home_triangles), in name order. model: the part (its nodes'
-  /// whole ids, its bodies); num_nodes: the length of the part's nodal arrays; node_reach:
-  /// per part node, its reach (inflated_boxes; empty without shells), held by the caller.
+  /// vertices: the contact surface's vertices the part holds (a new surface needs a new
+  /// patch); home: the surface's triangles around the vertices whose volume owner this rank is
+  /// (home_triangles), in name order. model: the part (its nodes' whole ids, its bodies);
+  /// num_nodes: the length of the part's nodal arrays; node_reach: per part node, its reach
+  /// (inflated_boxes; empty without shells), held by the caller.
   ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
                const Model& model, Index num_nodes, std::span<const double> node_reach = {});
   ~ContactPatch();
@@ -115,22 +116,20 @@ class ContactPatch {
   // every rank places), numbered in ascending whole id. Their states live in arrays of the
   // patch's own; the part's arrays are read and written for the kept nodes only.
   Index num_nodes() const { return static_cast<Index>(nodes_.size()); }
-  /// Patch node k's surface vertex, and its node in the part (-1 if not held there).
-  Index surface_vertex(Index k) const { return nodes_[k]; }
-  Index part_node(Index k) const { return vertices_.node[nodes_[k]]; }
-  /// The surface vertex whose whole id is `whole` (it must be one).
-  Index vertex(Index whole) const;
+  /// Patch node k's node in the part (-1 if not held there).
+  Index part_node(Index k) const { return known_[nodes_[k]].node; }
   /// The patch node whose whole id is `whole` (it must be one), and patch node k's whole id.
   Index node(Index whole) const;
-  Index whole(Index k) const { return vertices_.whole[nodes_[k]]; }
-  /// The rank that owns patch node k (its volume owner).
-  int owner(Index k) const { return vertices_.owner[nodes_[k]]; }
+  Index whole(Index k) const { return known_[nodes_[k]].whole; }
+  /// The rank that owns patch node k (its volume owner), and its body.
+  int owner(Index k) const { return known_[nodes_[k]].owner; }
+  int body(Index k) const { return known_[nodes_[k]].body; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
   std::span<Vec3> v() { return v_; }
-  /// The bytes of its arrays sized by the whole surface (per surface vertex).
-  long whole_surface_bytes() const;
+  /// The number of vertices it knows (what its per-vertex arrays are sized by).
+  Index known_vertices() const { return static_cast<Index>(known_.size()); }
   /// Per patch node: its reach (empty without shells).
   std::span<const double> node_reach() const { return reach_; }
   /// Per patch node: its inverse mass and held components (as a number: bit k = component
@@ -164,11 +163,11 @@ class ContactPatch {
 
  private:
   /// A plan's lists: the home nodes sent to each rank (part node ids), the nodes received
-  /// from each (surface vertex ids).
+  /// from each (known ids).
   struct PlanLists {
     std::map<int, std::vector<Index>> send, receive;
   };
-  /// Plans the exchange of `nodes` (ascending surface vertex ids) from their owners; with
+  /// Plans the exchange of `nodes` (known ids) from their owners; with
   /// `readers`, makes it the source of neighbors() and readers() (collective).
   PlanLists plan(const std::vector<Index>& nodes, bool readers);
   /// The Halo of a plan's lists, received into the patch's numbering.
@@ -176,52 +175,69 @@ class ContactPatch {
   /// neighbors() and readers() from a plan's lists.
   void find_readers(const PlanLists& lists);
   Halo* halo(PatchPlan plan) const;
-  /// The patch's nodes become `nodes` (ascending surface vertex ids; the kept ones among them):
+  /// The patch's nodes become `nodes` (known ids ascending in whole id; the kept ones among them):
   /// states kept for the nodes that stay, the primitives' ids and the plans renumbered.
   void renumber(std::vector<Index> nodes);
-  /// Appends node n to `nodes` unless marked, and marks it.
+  /// Appends known vertex n to `nodes` unless marked, and marks it.
   void add_node(Index n, std::vector<Index>& nodes);
-  /// Clears the marks of `nodes` (from add_node) and sorts them.
+  /// Clears the marks of `nodes` (from add_node) and sorts them by whole id.
   void sort_marked(std::vector<Index>& nodes);
-  /// The rings (the triangles around them) of the listed surface vertices that have none yet,
+  /// Sorts known vertices by whole id.
+  void sort_by_whole(std::vector<Index>& nodes) const;
+  /// The known id of the vertex `whole`, which becomes known with its owner and body if new.
+  Index know(Index whole, int owner, int body);
+  /// The known id of the vertex `whole` (it must be known).
+  Index known(Index whole) const;
+  /// Forgets every vertex but the patch's nodes, and the rings (fetched again when needed).
+  void forget();
+  /// The rings (the triangles around them) of the listed known vertices that have none yet,
   /// from their volume owners (collective).
   void fetch_rings(std::span<const Index> vertices);
   /// The index in ring_ of triangle t, added if new.
   Index ring_triangle(const NamedTriangle& t);
-  /// The ring of surface vertex v (fetched).
+  /// The ring of known vertex v (fetched).
   std::span<const Index> ring_of(Index v) const;
 
   const Decomposition& dec_;
-  const SurfaceVertices& vertices_;
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
+  /// A vertex the patch knows (its known id: its place in known_): those of the patch's
+  /// nodes, ghosts and rings, and the kept ones. Forgotten at a new ownership (forget()), so
+  /// they stay a patch's worth.
+  struct KnownVertex {
+    Index whole;          ///< its whole id
+    Index node;           ///< its node in the part, -1 if not held
+    int owner, body;      ///< its volume owner, its body
+    Index position = -1;  ///< its patch node, -1 if none
+    Index ring = -1;      ///< its ring (k: ring_offsets_[k]), -1 before it is fetched
+    bool mark = false;    ///< scratch of reach() and activate(), false between calls
+  };
+  std::vector<KnownVertex> known_;
+  std::unordered_map<Index, Index> known_at_;  ///< known id of a whole id
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
-  std::vector<Index> kept_;   ///< the surface vertices whose part rows the time loop keeps (load())
+  std::vector<Index> kept_;   ///< the known vertices whose part rows the time loop keeps (load()), ascending whole ids
   bool owned_once_ = false;
-  std::vector<std::array<Index, 2>> owned_edges_;  ///< owned_.edges in surface vertex ids (ascending)
+  std::vector<std::uint64_t> owned_edge_keys_;  ///< owned_.edges as edge_key of whole ids (ascending)
   ContactSurface owned_, patch_;
   SweptBoxes owned_boxes_;                  ///< inflated boxes of owned_ at the last reach()
   std::vector<Index> patch_edge_owned_at_;      ///< per edge of patch_: its owned edge, -1 for a ghost
   std::vector<std::uint8_t> patch_edge_owned_;  ///< per edge of patch_: 1 if owned
   ContactSurface normals_;
   VertexTriangles normals_around_;
-  std::vector<std::uint8_t> node_mark_;  ///< scratch of reach() and activate(), 0 between calls
   // The rings (docs/parallel.md "Patches with their own topology", step 2): the triangles
   // around the patch's vertices, which orient its pairs, from the vertices' volume owners.
   std::vector<NamedTriangle> home_;           ///< around the vertices whose volume owner this rank is
   std::vector<std::pair<Index, Index>> home_at_;  ///< (whole node, home_ index), ascending
-  ContactSurface ring_;                       ///< every triangle fetched, once (triangles and bodies; surface vertex ids)
+  ContactSurface ring_;                       ///< every triangle fetched, once (triangles and bodies; known ids)
   std::vector<std::int64_t> ring_keys_;  ///< per triangle of ring_: its name_key
   std::vector<std::uint8_t> ring_mark_;  ///< per triangle of ring_: scratch of activate(), 0 between calls
   std::map<std::int64_t, Index> ring_name_;  ///< ring_'s index of a triangle's name_key
-  std::vector<Index> ring_at_;  ///< per surface vertex: its ring (k: ring_offsets_[k]), -1 before it is fetched
   std::vector<Index> ring_offsets_{0}, ring_items_;  ///< the rings fetched, CSR: ring_ indices, name order
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
-  std::vector<Index> nodes_;        ///< per patch node: its surface vertex, ascending
-  std::vector<Index> position_;     ///< per surface vertex: its patch node, -1 if none
+  std::vector<Index> nodes_;        ///< per patch node: its known id, ascending whole ids
   std::vector<Index> kept_at_;      ///< per kept_: its patch node
   std::vector<Vec3> x_old_, x_new_, v_;
   std::vector<double> inv_mass_;

@@ -75,9 +75,17 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 }
 
 bool ContactStage::excluded(const ContactPair& p) const {
+  // On several ranks the pair is of patch nodes: their bodies come with them, and the twins
+  // (a whole model only) are a surface vertex's.
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
+  const auto body = [&](Index n) { return dec_ ? patch_->body(n) : node_body_[n]; };
+  const auto twin = [&](Index n) {
+    if (!dec_) return twin_of_[n];
+    const std::span<const Index> whole = vertices_.whole;
+    return twin_of_[std::lower_bound(whole.begin(), whole.end(), patch_->whole(n)) - whole.begin()];
+  };
   if (by_body()) {
-    const int a = body_[p.nodes[0]], b = body_[p.nodes[first]];
+    const int a = body(p.nodes[0]), b = body(p.nodes[first]);
     if ((!self_ || shell_body_[a]) && a == b) return true;
     // Free rigid bodies touch deformable ones only (DCR moves one rigid body per pair;
     // the scene refuses two that contact.pairs lets touch): their self-pairs drop.
@@ -89,7 +97,7 @@ bool ContactStage::excluded(const ContactPair& p) const {
   if (twin_of_.empty()) return false;
   for (int i = 0; i < first; ++i)
     for (int j = first; j < 4; ++j)
-      if (twin_of_[p.nodes[i]] == twin_of_[p.nodes[j]]) return true;
+      if (twin(p.nodes[i]) == twin(p.nodes[j])) return true;
   return false;
 }
 
@@ -100,9 +108,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
             (model_.is_part() ? model_.part.surface_edge : median_edge_length(surface_, mesh.reference));
   have_candidates_ = false;
   pairs_.clear();
-  body_ = {};
+  node_body_.clear();
   if (!dec_) {
-    if (by_body()) node_body_ = mesh.node_body, body_ = node_body_;
+    if (by_body()) node_body_ = mesh.node_body;
     vertex_triangles_ = vertex_triangles(surface_);
     return;
   }
@@ -125,6 +133,7 @@ void ContactStage::set_vertices(const Mesh& mesh) {
     vertices_.owner = part.surface_owner;
     vertices_.body = part.surface_body;
     for (const Index whole : part.surface_node) vertices_.node.push_back(model_.local_node(whole));
+    SHATTER_ASSERT(std::find(vertices_.node.begin(), vertices_.node.end(), -1) == vertices_.node.end());
   } else {
     vertices_.node = surface_.vertices;
     const std::vector<Index> at = vertex_triangles(surface_).position;
@@ -142,8 +151,6 @@ void ContactStage::set_vertices(const Mesh& mesh) {
     vertices_.owner = whole_tables_.owner;
     vertices_.body = whole_tables_.body;
   }
-  // excluded() reads the surface's ids: surface vertices here.
-  if (by_body()) body_ = vertices_.body;
   if (!twin_of_.empty()) {
     std::vector<Index> twin;
     for (const Index n : vertices_.node) twin.push_back(twin_of_[n]);
@@ -225,7 +232,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
     pairs_.clear();
     std::fill(weight_.begin(), weight_.end(), 0.0f);
     for (size_t k = 0; k < found.pairs.size(); ++k) {
-      if (excluded(surface_pair(found.pairs[k]))) continue;
+      if (excluded(found.pairs[k])) continue;
       pairs_.push_back(found.pairs[k]);
       weight_[patch_->owned_primitive(found.primitive[k])] += 1.0f;
     }
@@ -242,7 +249,11 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
 NamedTriangle ContactStage::named_triangle(Index t) const {
   const auto& n = surface_.triangles[t];
   const std::span<const Index> whole = vertices_.whole;
-  return {{t, 0, 0}, {whole[n[0]], whole[n[1]], whole[n[2]]}, surface_.body[t]};
+  const std::span<const int> owner = vertices_.owner;
+  return {{t, 0, 0},
+          {whole[n[0]], whole[n[1]], whole[n[2]]},
+          {owner[n[0]], owner[n[1]], owner[n[2]]},
+          surface_.body[t]};
 }
 
 NamedSurface ContactStage::first_owned() const {
@@ -253,7 +264,9 @@ NamedSurface ContactStage::first_owned() const {
   for (Index t = 0; t < surface_.num_triangles(); ++t)
     if (vertices_.owner[surface_.triangles[t][0]] == dec_->rank()) owned.triangles.push_back(named_triangle(t));
   for (const auto& [a, b] : surface_.edges)
-    if (vertices_.owner[a] == dec_->rank()) owned.edges.push_back({vertices_.whole[a], vertices_.whole[b]});
+    if (vertices_.owner[a] == dec_->rank())
+      owned.edges.push_back(
+          {{vertices_.whole[a], vertices_.whole[b]}, {vertices_.owner[a], vertices_.owner[b]}, vertices_.body[a]});
   return owned;
 }
 
@@ -284,13 +297,13 @@ void ContactStage::partition() {
   }
   for (size_t k = 0; k < ne; ++k) {
     const auto& n = at.edges[k];
-    names.insert(names.end(), {1, owned_.edges[k][0], owned_.edges[k][1], 0});
+    names.insert(names.end(), {1, owned_.edges[k].nodes[0], owned_.edges[k].nodes[1], 0});
     points.push_back(0.5 * (x[n[0]] + x[n[1]]));
   }
   for (const float w : weight_) weights.insert(weights.end(), {1.0f, 0.01f + w});
   const std::vector<int> to = partition_->partition(names, points, weights);
-  // The primitives that leave go to their new ranks with their data (a triangle: kind 0, then
-  // its words, append_words; an edge: kind 1, its nodes).
+  // The primitives that leave go to their new ranks with their data (kind 0 and a triangle's
+  // words, or kind 1 and an edge's: append_words).
   const int me = dec_->rank();
   NamedSurface kept;
   std::vector<std::vector<Index>> out(dec_->size());
@@ -304,21 +317,26 @@ void ContactStage::partition() {
     }
   }
   for (size_t k = 0; k < ne; ++k) {
-    if (to[nt + k] == me) kept.edges.push_back(owned_.edges[k]);
-    else out[to[nt + k]].insert(out[to[nt + k]].end(), {1, owned_.edges[k][0], owned_.edges[k][1]});
+    if (to[nt + k] == me) {
+      kept.edges.push_back(owned_.edges[k]);
+    } else {
+      out[to[nt + k]].push_back(1);
+      append_words(owned_.edges[k], out[to[nt + k]]);
+    }
   }
   for (const auto& list : dec_->alltoall(out))
     for (size_t i = 0; i < list.size();)
       if (list[i] == 0) {
-        kept.triangles.push_back(read_words(&list[i + 1]));
+        kept.triangles.push_back(read_triangle(&list[i + 1]));
         i += 1 + kNamedTriangleWords;
       } else {
-        kept.edges.push_back({list[i + 1], list[i + 2]});
-        i += 3;
+        kept.edges.push_back(read_edge(&list[i + 1]));
+        i += 1 + kNamedEdgeWords;
       }
   std::sort(kept.triangles.begin(), kept.triangles.end(),
             [](const NamedTriangle& a, const NamedTriangle& b) { return a.name < b.name; });
-  std::sort(kept.edges.begin(), kept.edges.end());
+  std::sort(kept.edges.begin(), kept.edges.end(),
+            [](const NamedEdge& a, const NamedEdge& b) { return a.nodes < b.nodes; });
   const long before = static_cast<long>(nt + ne), after = static_cast<long>(kept.triangles.size() + kept.edges.size());
   const std::vector<long> sums = dec_->sum(std::vector<long>{before, after});
   SHATTER_REQUIRE(sums[0] == sums[1], "ContactStage: " << sums[0] << " primitives before RCB, " << sums[1] << " after");
@@ -361,19 +379,20 @@ long ContactStage::whole_surface_bytes() const {
   auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
   return b(surface_.triangles) + b(surface_.body) + b(surface_.edges) + b(surface_.vertices) +
          b(vertex_triangles_.offsets) + b(vertex_triangles_.items) + b(vertex_triangles_.position) +
-         b(whole_tables_.whole) + b(whole_tables_.owner) + b(whole_tables_.body) + b(vertices_.node) +
-         b(node_body_) + b(twin_of_) +
-         (patch_ ? patch_->whole_surface_bytes() : 0);
+         b(whole_tables_.whole) + b(whole_tables_.owner) + b(whole_tables_.body) +
+         (model_.is_part() ? 0 : b(vertices_.node)) + b(node_body_) + b(twin_of_);
 }
 
 std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine) {
-  // Each rank's first pair (kind, whole ids of its nodes, their positions) to every rank.
-  constexpr size_t kWords = 5 + 12;
+  // Each rank's first pair (kind, whole ids of its nodes, their bodies and positions) to
+  // every rank.
+  constexpr size_t kWords = 9 + 12;
   std::vector<double> out;
   if (mine) {
     const std::span<const Vec3> at = patch_->x_new();
     out.push_back(mine->kind);
     for (const Index k : mine->nodes) out.push_back(patch_->whole(k));
+    for (const Index k : mine->nodes) out.push_back(patch_->body(k));
     for (const Index k : mine->nodes) out.insert(out.end(), at[k].data(), at[k].data() + 3);
   }
   const std::vector<double> all = dec_->allgather(out);
@@ -390,11 +409,10 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   u.kind = first->kind;
   std::array<long, 4> gid{};
   for (int c = 0; c < 4; ++c) {
-    const Index v = patch_->vertex(first->nodes[c]);
-    u.body[c] = vertices_.body[v];
-    const Index n = vertices_.node[v];
+    u.body[c] = static_cast<int>(all[at_first + 5 + c]);
+    const Index n = model_.local_node(first->nodes[c]);
     gid[c] = n >= 0 && dec_->owns_node(n) ? model_.mesh.node_gid[n] : -1;
-    u.x[c] = Vec3(all[at_first + 5 + 3 * c], all[at_first + 6 + 3 * c], all[at_first + 7 + 3 * c]);
+    u.x[c] = Vec3(all[at_first + 9 + 3 * c], all[at_first + 10 + 3 * c], all[at_first + 11 + 3 * c]);
   }
   MPI_Allreduce(MPI_IN_PLACE, gid.data(), 4, MPI_LONG, MPI_MAX, dec_->comm());
   for (int c = 0; c < 4; ++c) u.gid[c] = gid[c];
@@ -406,11 +424,6 @@ ContactPairs ContactStage::active_pairs() const {
   ContactPairs out(kept.size());
   for (size_t k = 0; k < kept.size(); ++k) out[k] = dec_ ? whole_pair(pairs_[kept[k]]) : pairs_[kept[k]];
   return out;
-}
-
-ContactPair ContactStage::surface_pair(ContactPair p) const {
-  for (Index& n : p.nodes) n = patch_->surface_vertex(n);
-  return p;
 }
 
 ContactPair ContactStage::whole_pair(ContactPair p) const {

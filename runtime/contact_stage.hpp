@@ -126,8 +126,7 @@ class ContactStage {
   Index surface_triangles() const {
     return model_.is_part() ? model_.part.surface_triangles : surface_.num_triangles();
   }
-  /// The surface's nodes, ascending (mesh node ids; on several ranks, -1 for a node the
-  /// part does not hold).
+  /// The surface's nodes, ascending (mesh node ids; on a part, those it holds).
   std::span<const Index> surface_nodes() const { return dec_ ? vertices_.node : surface_.vertices; }
   /// The candidates of the search in force (on several ranks, this rank's).
   const ContactPairs& candidates() const { return pairs_; }
@@ -161,12 +160,11 @@ class ContactStage {
   /// turned to surface vertex ids.
   void set_vertices(const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
-  /// Whether the pair (of the surface's ids: mesh nodes on one rank, surface vertices on
-  /// several) is left out: its primitives share a node, twins counted as one (rebuild), its
+  /// Whether the pair (mesh nodes on one rank, patch nodes on several) is left out: its primitives share a node, twins counted as one (rebuild), its
   /// bodies are not a pair of contact.pairs, they are one body and contact.self is false, or
   /// both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
-  /// Whether excluded() reads the pairs' bodies (body_).
+  /// Whether excluded() reads the pairs' bodies.
   bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
@@ -192,8 +190,7 @@ class ContactStage {
   /// The states of a plan's nodes from their owners (ContactPatch::exchange; timed and
   /// counted as exchange).
   void exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
-  /// A pair of patch nodes as surface vertices, or as whole-model nodes.
-  ContactPair surface_pair(ContactPair p) const;
+  /// A pair of patch nodes as whole-model nodes.
   ContactPair whole_pair(ContactPair p) const;
   /// Per patch node, its free rigid body (rigid.node_body's), from the part's rows.
   std::vector<std::int32_t> patch_rigid_bodies(const DcrRigidBodies& rigid) const;
@@ -201,7 +198,7 @@ class ContactStage {
   const Model& model_;
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
-  SurfaceVertices vertices_;          ///< several ranks: what is known of each surface vertex
+  SurfaceVertices vertices_;          ///< several ranks: the surface vertices held here
   /// A whole model on several ranks: the tables vertices_ views (a part's are in the part).
   struct {
     std::vector<Index> whole;
@@ -217,9 +214,7 @@ class ContactStage {
   bool self_ = true;                            ///< contact.self
   std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free
   bool any_free_rigid_ = false;
-  /// Per surface id, its body (with contact.pairs or contact.self: false, or shells): the
-  /// node_body_ copy on one rank, the vertices' bodies on several.
-  std::span<const int> body_;
+  /// One rank: per node, its body (with contact.pairs or contact.self: false, or shells).
   std::vector<int> node_body_;
   std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
   std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells (grows the search boxes: inflated_boxes)

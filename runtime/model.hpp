@@ -80,11 +80,11 @@ struct Model {
     std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
     /// Contact scenes: of the whole model's contact surface (build_contact_surface), the
-    /// number of triangles and, per surface vertex (vertex k: the surface's k-th node,
-    /// ascending in whole id), its whole id, its volume owner and its body. The triangles
-    /// are not held: each rank names those of its own elements (named_surface.hpp). The part
-    /// holds the rows of its elements' nodes and of the rigid bodies' surface nodes only
-    /// (docs/parallel.md "Patches with their own topology", steps 2 and 4).
+    /// number of triangles and, per surface vertex the part holds (ascending in whole id),
+    /// its whole id, its volume owner and its body. The triangles are not held: each rank
+    /// names those of its own elements (named_surface.hpp). The part holds the rows of its
+    /// elements' nodes and of the rigid bodies' surface nodes only (docs/parallel.md
+    /// "Patches with their own topology", steps 2 and 4).
     Index surface_triangles = 0;
     std::vector<Index> surface_node;
     std::vector<int> surface_owner, surface_body;

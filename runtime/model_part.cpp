@@ -28,7 +28,7 @@ struct Partition {
   NodeRanks touch;
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
-  // Contact scenes: the whole model's surface as the parts hold it (Model::Part).
+  // Contact scenes: the whole model's surface, of which each part holds its nodes' (Model::Part).
   Index surface_triangles = 0;
   std::vector<Index> surface_node;
   std::vector<int> surface_owner, surface_body;
@@ -150,9 +150,12 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   mesh.build_node_elements();
   m.load_faces = held_load_faces(whole.load_faces, part.element_index);
   part.surface_triangles = p.surface_triangles;
-  part.surface_node = p.surface_node;
-  part.surface_owner = p.surface_owner;
-  part.surface_body = p.surface_body;
+  for (size_t k = 0; k < p.surface_node.size(); ++k)
+    if (local[p.surface_node[k]] >= 0) {
+      part.surface_node.push_back(p.surface_node[k]);
+      part.surface_owner.push_back(p.surface_owner[k]);
+      part.surface_body.push_back(p.surface_body[k]);
+    }
   part.surface_edge = p.surface_edge;
   m.body_mass = whole.body_mass;
   m.body_volume = whole.body_volume;

@@ -13,16 +13,23 @@ namespace {
 /// Every boundary triangle of the part's mesh, named, in name order (local elements ascend in
 /// whole id). Faces the part misclassifies (of outer ghosts, whose
 /// neighbours it lacks) hold no node of an owned element.
-std::vector<NamedTriangle> part_boundary(const Model& model) {
+/// Their nodes' owners are right for the triangles of the elements sharing a node with an owned
+/// one (the first ghost layer's ranks are the start-up rank's, or whole stars with two layers),
+/// which are all that leave here (-1: a node no rank touches).
+std::vector<NamedTriangle> part_boundary(const Model& model, const Decomposition& dec) {
   const Mesh& mesh = model.mesh;
+  const auto owner = [&](Index n) { return dec.distributed() && dec.node_ranks(n).empty() ? -1 : dec.node_owner(n); };
   std::vector<NamedTriangle> out;
   for (const auto& [e, f] : boundary_faces(mesh)) {
     const Index* n = mesh.element(e);
     const auto subs = face_triangles(mesh.order, f);
-    for (size_t s = 0; s < subs.size(); ++s)
+    for (size_t s = 0; s < subs.size(); ++s) {
+      const Index a = n[subs[s][0]], b = n[subs[s][1]], c = n[subs[s][2]];
       out.push_back({{model.whole_element(e), f, static_cast<Index>(s)},
-                     {model.whole_node(n[subs[s][0]]), model.whole_node(n[subs[s][1]]), model.whole_node(n[subs[s][2]])},
+                     {model.whole_node(a), model.whole_node(b), model.whole_node(c)},
+                     {owner(a), owner(b), owner(c)},
                      mesh.elem_body[e]});
+    }
   }
   return out;
 }
@@ -32,35 +39,43 @@ std::vector<NamedTriangle> part_boundary(const Model& model) {
 void append_words(const NamedTriangle& t, std::vector<Index>& out) {
   out.insert(out.end(), t.name.begin(), t.name.end());
   out.insert(out.end(), t.nodes.begin(), t.nodes.end());
+  out.insert(out.end(), t.owner.begin(), t.owner.end());
   out.push_back(t.body);
 }
 
-NamedTriangle read_words(const Index* w) {
-  return {{w[0], w[1], w[2]}, {w[3], w[4], w[5]}, static_cast<int>(w[6])};
+void append_words(const NamedEdge& e, std::vector<Index>& out) {
+  out.insert(out.end(), {e.nodes[0], e.nodes[1], e.owner[0], e.owner[1], e.body});
 }
+
+NamedTriangle read_triangle(const Index* w) {
+  return {{w[0], w[1], w[2]}, {w[3], w[4], w[5]}, {w[6], w[7], w[8]}, static_cast<int>(w[9])};
+}
+
+NamedEdge read_edge(const Index* w) { return {{w[0], w[1]}, {w[2], w[3]}, static_cast<int>(w[4])}; }
 
 NamedSurface owned_surface(const Model& model, const Decomposition& dec) {
   // The part's triangles, owned or not: those of ghost elements name the edges' smallest
   // triangles too; the misclassified ones share no edge with an owned triangle.
   struct Seen {
-    std::array<Index, 2> edge;  ///< whole ids, ascending
+    NamedEdge edge;  ///< nodes ascending
     std::array<Index, 3> name;
     bool owned;
   };
   NamedSurface out;
   std::vector<Seen> seen;
-  for (const NamedTriangle& t : part_boundary(model)) {
+  for (const NamedTriangle& t : part_boundary(model, dec)) {
     const bool owned = dec.owns_element(model.local_element(t.name[0]));
     if (owned) out.triangles.push_back(t);
     for (int c = 0; c < 3; ++c) {
-      const Index a = t.nodes[c], b = t.nodes[(c + 1) % 3];
-      seen.push_back({{std::min(a, b), std::max(a, b)}, t.name, owned});
+      const int a = c, b = (c + 1) % 3, lo = t.nodes[a] < t.nodes[b] ? a : b, hi = a + b - lo;
+      seen.push_back({{{t.nodes[lo], t.nodes[hi]}, {t.owner[lo], t.owner[hi]}, t.body}, t.name, owned});
     }
   }
-  std::sort(seen.begin(), seen.end(),
-            [](const Seen& p, const Seen& q) { return std::tie(p.edge, p.name) < std::tie(q.edge, q.name); });
+  std::sort(seen.begin(), seen.end(), [](const Seen& p, const Seen& q) {
+    return std::tie(p.edge.nodes, p.name) < std::tie(q.edge.nodes, q.name);
+  });
   for (size_t i = 0; i < seen.size(); ++i)
-    if ((i == 0 || seen[i].edge != seen[i - 1].edge) && seen[i].owned) out.edges.push_back(seen[i].edge);
+    if ((i == 0 || seen[i].edge.nodes != seen[i - 1].edge.nodes) && seen[i].owned) out.edges.push_back(seen[i].edge);
   return out;
 }
 
@@ -72,7 +87,7 @@ std::vector<NamedTriangle> home_triangles(const Model& model, const Decompositio
     return n >= 0 && (!dec.distributed() || (!dec.node_ranks(n).empty() && dec.node_owner(n) == dec.rank()));
   };
   std::vector<NamedTriangle> out;
-  for (const NamedTriangle& t : part_boundary(model))
+  for (const NamedTriangle& t : part_boundary(model, dec))
     if (home(t.nodes[0]) || home(t.nodes[1]) || home(t.nodes[2])) out.push_back(t);
   return out;
 }

@@ -27,11 +27,23 @@ class Decomposition;
 struct Model;
 
 /// A triangle of the contact surface named by where it comes from.
+/// Its nodes' volume owners travel with it, so a rank that holds no table of the surface's
+/// vertices knows whom to ask for their states (ContactPatch).
 struct NamedTriangle {
   std::array<Index, 3> name;   ///< whole element, local face (outward face), sub-triangle (face_triangles)
   std::array<Index, 3> nodes;  ///< whole node ids, counter-clockwise seen from outside
+  std::array<int, 3> owner;    ///< per node: its volume owner (Decomposition::node_owner)
   int body = 0;                ///< the element's body
   friend bool operator==(const NamedTriangle&, const NamedTriangle&) = default;
+};
+
+/// An edge of the contact surface: its nodes' whole ids, ascending, with their volume owners
+/// and its body.
+struct NamedEdge {
+  std::array<Index, 2> nodes;
+  std::array<int, 2> owner;
+  int body = 0;
+  friend bool operator==(const NamedEdge&, const NamedEdge&) = default;
 };
 
 /// A triangle's name as one number of the same order (faces and sub-triangles are 0-3).
@@ -39,16 +51,19 @@ inline std::int64_t name_key(const std::array<Index, 3>& name) {
   return 16 * static_cast<std::int64_t>(name[0]) + 4 * name[1] + name[2];
 }
 
-/// A triangle in a message: kNamedTriangleWords numbers (name, nodes, body), appended to `out`
-/// by append_words and read back by read_words from its first.
-inline constexpr std::size_t kNamedTriangleWords = 7;
+/// A primitive in a message: kNamedTriangleWords numbers (name, nodes, owners, body) or
+/// kNamedEdgeWords (nodes, owners, body), appended to `out` by append_words and read back by
+/// read_triangle / read_edge from its first.
+inline constexpr std::size_t kNamedTriangleWords = 10, kNamedEdgeWords = 5;
 void append_words(const NamedTriangle& t, std::vector<Index>& out);
-NamedTriangle read_words(const Index* words);
+void append_words(const NamedEdge& e, std::vector<Index>& out);
+NamedTriangle read_triangle(const Index* words);
+NamedEdge read_edge(const Index* words);
 
 /// A rank's share of the contact surface's primitives.
 struct NamedSurface {
   std::vector<NamedTriangle> triangles;     ///< the owned elements' boundary triangles, ascending names
-  std::vector<std::array<Index, 2>> edges;  ///< the edges owned first here: whole ids a < b, ascending
+  std::vector<NamedEdge> edges;             ///< the edges owned first here, ascending nodes
 };
 
 /// This rank's share of the surface of the model's mesh (a part with its first ghost layer,

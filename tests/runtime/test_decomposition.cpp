@@ -316,8 +316,9 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
 
 TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   // A contact scene's part holds the rows of its elements' nodes and of the rigid
-  // bodies' surface nodes only; of the whole surface it brings each vertex's whole id,
-  // volume owner and body, the median edge and the number of triangles, not the triangles.
+  // bodies' surface nodes only; of the whole surface it brings the whole id, volume
+  // owner and body of each vertex it holds, the median edge and the number of triangles,
+  // not the triangles nor the vertices held elsewhere.
   const Scene scene = rank_scene(
       "contact_parts",
       "name: contact_parts\ntime: {end: 1.0e-5}\n"
@@ -333,29 +334,36 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   if (!part.is_part()) return;
   const ContactSurface surface = build_contact_surface(whole.mesh);
   const Model::Part& p = part.part;
-  EXPECT_EQ(p.surface_node, surface.vertices);
   EXPECT_EQ(p.surface_edge, median_edge_length(surface, whole.mesh.reference));
   EXPECT_EQ(p.surface_triangles, surface.num_triangles());
   const Decomposition d(part, MPI_COMM_WORLD);
   std::vector<char> in_element(part.mesh.num_nodes(), 0);
   for (Index e = 0; e < part.mesh.num_elements(); ++e)
     for (int a = 0; a < part.mesh.nodes_per_element(); ++a) in_element[part.mesh.element(e)[a]] = 1;
+  std::vector<Index> held;
   long surface_only_elsewhere = 0;
-  for (size_t k = 0; k < surface.vertices.size(); ++k) {
-    const Index n = part.local_node(surface.vertices[k]);
-    EXPECT_EQ(p.surface_body[k], whole.mesh.node_body[surface.vertices[k]]);
-    const bool rigid = scene.bodies[p.surface_body[k]].has_rigid_state();
+  for (const Index v : surface.vertices) {
+    const Index n = part.local_node(v);
+    const bool rigid = scene.bodies[whole.mesh.node_body[v]].has_rigid_state();
     if (n < 0) {
-      EXPECT_FALSE(rigid) << "a rigid body's surface node " << surface.vertices[k] << " is not held";
+      EXPECT_FALSE(rigid) << "a rigid body's surface node " << v << " is not held";
       ++surface_only_elsewhere;
       continue;
     }
-    EXPECT_TRUE(in_element[n] || rigid) << "surface node " << surface.vertices[k] << " held outside the elements";
+    EXPECT_TRUE(in_element[n] || rigid) << "surface node " << v << " held outside the elements";
+    held.push_back(v);
+  }
+  EXPECT_GT(surface_only_elsewhere, 0) << "every part held every surface node";
+  ASSERT_EQ(p.surface_node, held);
+  ASSERT_EQ(p.surface_owner.size(), held.size());
+  ASSERT_EQ(p.surface_body.size(), held.size());
+  for (size_t k = 0; k < held.size(); ++k) {
+    EXPECT_EQ(p.surface_body[k], whole.mesh.node_body[held[k]]);
+    const Index n = part.local_node(held[k]);
     if (in_element[n]) {
       EXPECT_EQ(p.surface_owner[k], d.node_owner(n));
     }
   }
-  EXPECT_GT(surface_only_elsewhere, 0) << "every part held every surface node";
 }
 
 TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {

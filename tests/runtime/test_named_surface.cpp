@@ -46,19 +46,23 @@ void check_order(int order) {
     ASSERT_GE(e, 0);
     EXPECT_TRUE(dec.owns_element(e)) << "triangle of element " << t.name[0] << " named by a rank not owning it";
   }
-  // Every rank's lists on every rank: a triangle as its words (append_words).
+  // Every rank's lists on every rank: a primitive as its words (append_words).
   std::vector<Index> flat, edges;
   for (const NamedTriangle& t : mine.triangles) append_words(t, flat);
-  for (const auto& e : mine.edges) edges.insert(edges.end(), e.begin(), e.end());
+  for (const NamedEdge& e : mine.edges) append_words(e, edges);
   flat = dec.allgather(flat);
   edges = dec.allgather(edges);
   std::vector<NamedTriangle> all;
   for (size_t k = 0; k + kNamedTriangleWords <= flat.size(); k += kNamedTriangleWords)
-    all.push_back(read_words(&flat[k]));
+    all.push_back(read_triangle(&flat[k]));
   std::sort(all.begin(), all.end(), [](const NamedTriangle& a, const NamedTriangle& b) { return a.name < b.name; });
+  std::vector<NamedEdge> named_edges;
+  for (size_t k = 0; k + kNamedEdgeWords <= edges.size(); k += kNamedEdgeWords)
+    named_edges.push_back(read_edge(&edges[k]));
+  std::sort(named_edges.begin(), named_edges.end(),
+            [](const NamedEdge& a, const NamedEdge& b) { return a.nodes < b.nodes; });
   std::vector<std::array<Index, 2>> all_edges;
-  for (size_t k = 0; k + 2 <= edges.size(); k += 2) all_edges.push_back({edges[k], edges[k + 1]});
-  std::sort(all_edges.begin(), all_edges.end());
+  for (const NamedEdge& e : named_edges) all_edges.push_back(e.nodes);
   EXPECT_EQ(std::adjacent_find(all_edges.begin(), all_edges.end()), all_edges.end()) << "an edge listed twice";
 
   // The one-rank surface (whole mesh ids are whole ids), in the same order.
@@ -96,6 +100,22 @@ void check_order(int order) {
   long counts[2] = {checked, static_cast<long>(surface.vertices.size())};
   MPI_Allreduce(MPI_IN_PLACE, counts, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(counts[0], counts[1]) << "surface nodes with no volume owner, or with two";
+
+  // Each primitive carries its nodes' volume owners (those each rank says it is) and the body.
+  std::vector<Index> homes;
+  for (const Index whole_id : surface.vertices)
+    if (const Index n = part.local_node(whole_id);
+        n >= 0 && (ranks == 1 || (!dec.node_ranks(n).empty() && dec.node_owner(n) == rank)))
+      homes.insert(homes.end(), {whole_id, rank});
+  homes = dec.allgather(homes);
+  std::vector<int> owner_of(whole.mesh.num_nodes(), -1);
+  for (size_t k = 0; k + 2 <= homes.size(); k += 2) owner_of[homes[k]] = static_cast<int>(homes[k + 1]);
+  for (const NamedTriangle& t : all)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(t.owner[c], owner_of[t.nodes[c]]) << "node " << t.nodes[c];
+  for (const NamedEdge& e : named_edges) {
+    for (int c = 0; c < 2; ++c) EXPECT_EQ(e.owner[c], owner_of[e.nodes[c]]) << "node " << e.nodes[c];
+    EXPECT_EQ(e.body, whole.mesh.node_body[e.nodes[0]]);
+  }
 }
 
 TEST(NamedSurface, RanksNameTheWholeSurfaceOnceTet4) { check_order(1); }
