@@ -200,14 +200,14 @@ else
   max_ranks=${4:-64}
   out="$here/results/mpi_scaling_weak${SET:+_${SET%%=*}}.csv"
   extra=(); [ -n "${SET:-}" ] && extra=(--set "$SET")
-  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,contact_searches,contact_repartitions,contact_state_bytes_max,contact_found_bytes_max,contact_search_cpu_ms_per_step_max,contact_dcr_cpu_ms_per_step_max,contact_whole_surface_kB" > "$out"
+  echo "ranks,elements,owned_min,owned_max,local_max,ghost_bytes_max,ghost_messages_max,shared_surface_bytes,reduction_bytes,contact_pairs_min,contact_pairs_max,contact_gather_bytes,peak_rank0_MB,peak_others_max_MB,peak_sum_MB,model_bytes_per_rank_max_MB,steps,contact_searches,contact_repartitions,contact_state_bytes_max,contact_found_bytes_max,contact_search_cpu_ms_per_step_max,contact_dcr_cpu_ms_per_step_max,contact_whole_surface_kB,contact_patch_vertices_max,contact_surface_triangles" > "$out"
   r=${FIRST:-1}
   while [ "$r" -le "$max_ranks" ]; do
     h=$(size_for $((per_rank * r)))
     dir="$work/weak$r"
     "${mpi[@]}" --bind-to none -n "$r" "$shatter" run "$scene" --out "$dir" --threads 1 --quiet --set time.end=2.0e-4 \
       --set "bodies[0].mesh.element_size=$h" --set "bodies[1].mesh.element_size=$h" "${extra[@]}"
-    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max),$(contact "$dir"),$(key "$dir" contact_whole_surface_bytes_max | awk '{printf "%.0f", $1 / 1e3}')" | tee -a "$out"
+    echo "$r,$(key "$dir" elements),$(key "$dir" owned_elements_min),$(key "$dir" owned_elements_max),$(key "$dir" local_elements_max),$(key "$dir" ghost_bytes_per_step_max),$(key "$dir" ghost_messages_per_step_max),$(key "$dir" shared_surface_bytes_per_step),$(key "$dir" reduction_bytes_per_step),$(key "$dir" contact_pairs_per_step_rank_min),$(key "$dir" contact_pairs_per_step_rank_max),$(key "$dir" contact_exchange_bytes_per_step),$(peaks "$dir"),$(mb "$dir" model_bytes_per_rank_max),$(contact "$dir"),$(key "$dir" contact_whole_surface_bytes_max | awk '{printf "%.0f", $1 / 1e3}'),$(key "$dir" contact_patch_vertices_max),$(key "$dir" contact_surface_triangles)" | tee -a "$out"
     r=$((r * 2))
   done
 fi

@@ -123,8 +123,9 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
 }
 
 void ContactStage::set_vertices(const Mesh& mesh) {
-  // On ranks the topology is in surface vertex ids (vertex k of the surface), which the
-  // patch maps to the part's nodes (docs/parallel.md "Patches with their own topology").
+  // The patch starts from the surface vertices held here (docs/parallel.md "Patches with
+  // their own topology"); a whole model's topology is in surface vertex ids (vertex k of the
+  // surface).
   vertices_ = {};
   whole_tables_ = {};
   if (model_.is_part()) {
@@ -244,6 +245,7 @@ void ContactStage::search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, st
   }
   patch_->activate(pairs_);
   exchange(x_old, x_new, v, PatchPlan::Active);
+  profile_.known_vertices_max = std::max<long>(profile_.known_vertices_max, patch_->known_vertices());
 }
 
 NamedTriangle ContactStage::named_triangle(Index t) const {
@@ -362,15 +364,16 @@ ContactBalance ContactStage::balance() const {
   const ContactProfile& p = profile_;
   ContactBalance b{p.owned_pairs,     p.owned_pairs, p.owned_pairs,        p.candidates,
                    p.states_posted,   p.state_bytes, p.found_bytes,        p.search_cpu_seconds,
-                   p.sweep_cpu_seconds, whole_surface_bytes()};
+                   p.sweep_cpu_seconds, whole_surface_bytes(), p.known_vertices_max};
   if (dec_) {
-    long most[5] = {-b.pairs_min, b.pairs_max, b.state_bytes_max, b.found_bytes_max, b.whole_surface_bytes_max},
+    long most[6] = {-b.pairs_min,       b.pairs_max,         b.state_bytes_max, b.found_bytes_max,
+                    b.whole_surface_bytes_max, b.known_vertices_max},
          sum[3] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum};
     double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
-    MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_LONG, MPI_MAX, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, most, 6, MPI_LONG, MPI_MAX, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_LONG, MPI_SUM, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
-    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4]};
+    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4], most[5]};
   }
   return b;
 }

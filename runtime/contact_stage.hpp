@@ -58,6 +58,7 @@ struct ContactProfile {
   long states_posted = 0;       ///< node states passed to the rank of the node's next pair
   double exchange_seconds = 0;  ///< in those gathers (not in the times above)
   long repartitions = 0;        ///< RCB partitions computed
+  long known_vertices_max = 0;  ///< the most surface vertices its patch knew at a search (ContactPatch::known_vertices)
   // Thread CPU time of the work itself (meaningful when ranks share cores):
   double search_cpu_seconds = 0;  ///< the searches' boxes, bucket search and filter
   double sweep_cpu_seconds = 0;   ///< DCR, less the gathers
@@ -80,6 +81,7 @@ struct ContactBalance {
   long state_bytes_max = 0, found_bytes_max = 0;
   double search_cpu_max = 0, sweep_cpu_max = 0;
   long whole_surface_bytes_max = 0;  ///< ContactStage::whole_surface_bytes
+  long known_vertices_max = 0;       ///< ContactProfile::known_vertices_max
 };
 
 class Decomposition;
@@ -153,11 +155,11 @@ class ContactStage {
   double margin() const { return margin_; }
 
  private:
-  /// The surface (of `mesh`'s nodes; on a part, of surface vertex ids) and what depends on
-  /// it: the search margin, the candidates, the RCB order.
+  /// The surface (of `mesh`'s nodes; on a part, empty) and what depends on it: the search
+  /// margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
-  /// On several ranks: vertices_, with the surface (of mesh node ids on a whole model)
-  /// turned to surface vertex ids.
+  /// On several ranks: vertices_ (on a part, the surface vertices it holds), with the surface
+  /// (of mesh node ids on a whole model) turned to surface vertex ids.
   void set_vertices(const Mesh& mesh);
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   /// Whether the pair (mesh nodes on one rank, patch nodes on several) is left out: its primitives share a node, twins counted as one (rebuild), its

@@ -46,7 +46,7 @@ Partition partition(const Model& whole, int ranks) {
   for (Index n = 0; n < mesh.num_nodes(); ++n)
     if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;
   if (!whole.scene.contact) return p;
-  // The surface in surface vertex ids, and what every part knows of each vertex.
+  // The surface's vertices, and what a part holding one knows of it (cut() keeps a part's).
   const ContactSurface surface = build_contact_surface(mesh);
   p.surface_edge = median_edge_length(surface, mesh.reference);
   p.surface_triangles = surface.num_triangles();

@@ -336,6 +336,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
       j.add("contact_dcr_cpu_time_max", contact_balance.sweep_cpu_max);
       j.add("contact_repartitions", cp.repartitions);
       j.add("contact_whole_surface_bytes_max", contact_balance.whole_surface_bytes_max);
+      j.add("contact_patch_vertices_max", contact_balance.known_vertices_max);
     }
   }
   j.write(opt_.out_dir / "summary.json");
