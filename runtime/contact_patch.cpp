@@ -54,7 +54,8 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
 
 ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vertices, std::vector<NamedTriangle> home,
                            const Model& model, Index num_nodes, std::span<const double> node_reach)
-    : dec_(dec), model_(model), num_nodes_(num_nodes), part_reach_(node_reach), home_(std::move(home)) {
+    : dec_(dec), vertices_(vertices), model_(model), num_nodes_(num_nodes), part_reach_(node_reach),
+      home_(std::move(home)) {
   for (size_t t = 0; t < home_.size(); ++t)
     for (const Index n : home_[t].nodes) home_at_.emplace_back(n, static_cast<Index>(t));
   std::sort(home_at_.begin(), home_at_.end());
@@ -66,11 +67,12 @@ ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vert
     const std::span<const int> ranks = dec.node_ranks(n);
     const bool touches = std::binary_search(ranks.begin(), ranks.end(), dec.rank());
     const bool rigid = model.scene.bodies[vertices.body[k]].has_rigid_state();
-    if (touches || rigid) kept_.push_back(know(vertices.whole[k], vertices.owner[k], vertices.body[k]));
+    const Index twin = vertices.twin.empty() ? vertices.whole[k] : vertices.twin[k];
+    if (touches || rigid) kept_.push_back(know(vertices.whole[k], vertices.owner[k], vertices.body[k], twin));
     if (!touches) continue;
     for (const int r : ranks)
       if (r != dec.rank()) touching_.push_back(r);
-    if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n);
+    if (vertices.owner[k] == dec.rank()) volume_vertices_.vertices.push_back(n), volume_twin_.push_back(twin);
   }
   sort_unique(touching_);
   renumber(kept_);
@@ -78,10 +80,16 @@ ContactPatch::ContactPatch(const Decomposition& dec, const SurfaceVertices& vert
 
 ContactPatch::~ContactPatch() = default;
 
-Index ContactPatch::know(Index whole, int owner, int body) {
+Index ContactPatch::know(Index whole, int owner, int body, Index twin) {
   const auto [it, fresh] = known_at_.try_emplace(whole, static_cast<Index>(known_.size()));
-  if (fresh) known_.push_back({whole, model_.local_node(whole), owner, body});
+  if (fresh) known_.push_back({whole, held(whole), owner, body, twin});
   return it->second;
+}
+
+Index ContactPatch::held(Index whole) const {
+  const std::span<const Index> ids = vertices_.whole;
+  const auto it = std::lower_bound(ids.begin(), ids.end(), whole);
+  return it != ids.end() && *it == whole ? vertices_.node[it - ids.begin()] : -1;
 }
 
 Index ContactPatch::known(Index whole) const {
@@ -175,13 +183,14 @@ void ContactPatch::own(const NamedSurface& primitives) {
   ContactSurface owned;
   for (const NamedTriangle& t : primitives.triangles) {
     std::array<Index, 3> k;
-    for (int c = 0; c < 3; ++c) k[c] = know(t.nodes[c], t.owner[c], t.body);
+    for (int c = 0; c < 3; ++c) k[c] = know(t.nodes[c], t.owner[c], t.body, t.twin[c]);
     owned.triangles.push_back(k);
     owned.body.push_back(t.body);
   }
   owned_edge_keys_.clear();
   for (const NamedEdge& e : primitives.edges) {
-    owned.edges.push_back({know(e.nodes[0], e.owner[0], e.body), know(e.nodes[1], e.owner[1], e.body)});
+    owned.edges.push_back(
+        {know(e.nodes[0], e.owner[0], e.body, e.twin[0]), know(e.nodes[1], e.owner[1], e.body, e.twin[1])});
     owned_edge_keys_.push_back(edge_key(e.nodes[0], e.nodes[1]));
   }
   SHATTER_REQUIRE(std::is_sorted(owned_edge_keys_.begin(), owned_edge_keys_.end()) &&
@@ -231,20 +240,20 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (int r = 0; r < ranks; ++r)
     boxes[r] = {Vec3(reach[6 * r], reach[6 * r + 1], reach[6 * r + 2]),
                 Vec3(reach[6 * r + 3], reach[6 * r + 4], reach[6 * r + 5])};
-  // Edges as their words (append_words: whole ids, owners, body), vertices as -(whole id +
-  // 1) and their body (their owner is the sender).
+  // Edges as their words (append_words: whole ids, owners, twins, body), vertices as -(whole
+  // id + 1), their body and twin class (their owner is the sender).
   std::vector<std::vector<Index>> to(ranks);
   for (size_t k = 0; k < owned_.edges.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (r != me && boxes_overlap(own.edges[k], boxes[r])) {
         const auto& [a, b] = owned_.edges[k];
-        append_words(NamedEdge{{whole(a), whole(b)}, {owner(a), owner(b)}, body(a)}, to[r]);
+        append_words(NamedEdge{{whole(a), whole(b)}, {owner(a), owner(b)}, {twin(a), twin(b)}, body(a)}, to[r]);
       }
   for (size_t k = 0; k < volume_vertices_.vertices.size(); ++k)
     for (int r = 0; r < ranks; ++r)
       if (boxes_overlap(home.vertices[k], boxes[r])) {
         const Index n = volume_vertices_.vertices[k];
-        to[r].insert(to[r].end(), {-(model_.whole_node(n) + 1), model_.mesh.node_body[n]});
+        to[r].insert(to[r].end(), {-(model_.whole_node(n) + 1), model_.mesh.node_body[n], volume_twin_[k]});
       }
   // The ghost edges sorted by their whole ids, then the patch's edges: the owned ones
   // (ascending) and the ghosts merged, each with its owned edge.
@@ -254,12 +263,12 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (int r = 0; r < ranks; ++r)
     for (size_t at = 0; at < received[r].size();)
       if (const Index* w = &received[r][at]; w[0] < 0) {
-        vertices.push_back(know(-w[0] - 1, r, static_cast<int>(w[1])));
-        at += 2;
+        vertices.push_back(know(-w[0] - 1, r, static_cast<int>(w[1]), w[2]));
+        at += 3;
       } else {
         const NamedEdge e = read_edge(w);
-        ghosts.push_back({edge_key(e.nodes[0], e.nodes[1]),
-                          {know(e.nodes[0], e.owner[0], e.body), know(e.nodes[1], e.owner[1], e.body)}});
+        ghosts.push_back({edge_key(e.nodes[0], e.nodes[1]), {know(e.nodes[0], e.owner[0], e.body, e.twin[0]),
+                                                              know(e.nodes[1], e.owner[1], e.body, e.twin[1])}});
         at += kNamedEdgeWords;
       }
   std::sort(ghosts.begin(), ghosts.end());
@@ -367,8 +376,9 @@ Index ContactPatch::ring_triangle(const NamedTriangle& t) {
   const std::int64_t key = name_key(t.name);
   const auto [it, fresh] = ring_name_.try_emplace(key, ring_.num_triangles());
   if (fresh) {
-    ring_.triangles.push_back({know(t.nodes[0], t.owner[0], t.body), know(t.nodes[1], t.owner[1], t.body),
-                               know(t.nodes[2], t.owner[2], t.body)});
+    ring_.triangles.push_back({know(t.nodes[0], t.owner[0], t.body, t.twin[0]),
+                               know(t.nodes[1], t.owner[1], t.body, t.twin[1]),
+                               know(t.nodes[2], t.owner[2], t.body, t.twin[2])});
     ring_.body.push_back(t.body);
     ring_keys_.push_back(key);
   }
@@ -448,7 +458,7 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
     for (const Index whole : asked[r]) {
-      const Index n = model_.local_node(whole);
+      const Index n = held(whole);
       SHATTER_ASSERT(n >= 0);
       lists.send[r].push_back(n);
     }

@@ -44,14 +44,14 @@ SweptBoxes inflated_boxes(const ContactSurface& surface, std::span<const Vec3> x
                           double margin, std::span<const double> reach = {});
 
 /// What a rank knows of the contact surface's vertices it holds (ContactStage holds it): per
-/// vertex, ascending in whole id. whole, owner and body view the part's tables
-/// (Model::Part::surface_node, surface_owner, surface_body: the surface vertices the part
-/// holds) on a part, the stage's own on a whole model (every vertex).
+/// vertex, ascending in whole id. On a part, the surface nodes it touches and the rigid
+/// bodies' (which every part holds); on a whole model, every vertex.
 struct SurfaceVertices {
   std::span<const Index> whole;  ///< its node's whole-model id
   std::vector<Index> node;       ///< its node in the part
   std::span<const int> owner;    ///< its volume owner
   std::span<const int> body;     ///< its node's body
+  std::span<const Index> twin;   ///< its twin class (Bonded::twin); empty: every vertex its own
 };
 
 /// Which nodes' states ContactPatch::exchange brings: the owned primitives' (own()), the
@@ -121,9 +121,11 @@ class ContactPatch {
   /// The patch node whose whole id is `whole` (it must be one), and patch node k's whole id.
   Index node(Index whole) const;
   Index whole(Index k) const { return known_[nodes_[k]].whole; }
-  /// The rank that owns patch node k (its volume owner), and its body.
+  /// The rank that owns patch node k (its volume owner), its body and its twin class (the
+  /// whole id of the smallest node bonded facets join to it, its own if none).
   int owner(Index k) const { return known_[nodes_[k]].owner; }
   int body(Index k) const { return known_[nodes_[k]].body; }
+  Index twin(Index k) const { return known_[nodes_[k]].twin; }
   /// The patch's states: x(n), x(n+1) and v(n+1/2) per patch node.
   std::span<Vec3> x_old() { return x_old_; }
   std::span<Vec3> x_new() { return x_new_; }
@@ -184,8 +186,11 @@ class ContactPatch {
   void sort_marked(std::vector<Index>& nodes);
   /// Sorts known vertices by whole id.
   void sort_by_whole(std::vector<Index>& nodes) const;
-  /// The known id of the vertex `whole`, which becomes known with its owner and body if new.
-  Index know(Index whole, int owner, int body);
+  /// The known id of the vertex `whole`, which becomes known with its owner, body and twin
+  /// class if new.
+  Index know(Index whole, int owner, int body, Index twin);
+  /// The part node of the surface vertex `whole` if the part holds it in vertices_, else -1.
+  Index held(Index whole) const;
   /// The known id of the vertex `whole` (it must be known).
   Index known(Index whole) const;
   /// Forgets every vertex but the patch's nodes, and the rings (fetched again when needed).
@@ -199,6 +204,7 @@ class ContactPatch {
   std::span<const Index> ring_of(Index v) const;
 
   const Decomposition& dec_;
+  const SurfaceVertices& vertices_;
   const Model& model_;
   Index num_nodes_;
   std::span<const double> part_reach_;
@@ -209,6 +215,7 @@ class ContactPatch {
     Index whole;          ///< its whole id
     Index node;           ///< its node in the part, -1 if not held
     int owner, body;      ///< its volume owner, its body
+    Index twin;           ///< its twin class (twin())
     Index position = -1;  ///< its patch node, -1 if none
     Index ring = -1;      ///< its ring (k: ring_offsets_[k]), -1 before it is fetched
     bool mark = false;    ///< scratch of reach() and activate(), false between calls
@@ -216,6 +223,7 @@ class ContactPatch {
   std::vector<KnownVertex> known_;
   std::unordered_map<Index, Index> known_at_;  ///< known id of a whole id
   ContactSurface volume_vertices_;  ///< the surface vertices this rank's volume owns (vertices only)
+  std::vector<Index> volume_twin_;  ///< per volume vertex: its twin class
   std::vector<Index> kept_;   ///< the known vertices whose part rows the time loop keeps (load()), ascending whole ids
   bool owned_once_ = false;
   std::vector<std::uint64_t> owned_edge_keys_;  ///< owned_.edges as edge_key of whole ids (ascending)

@@ -40,9 +40,14 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
     for (Index v = 0; v < shell.mesh.num_vertices(); ++v) reach_[shell.first_node + v] = 0.5 * shell.thickness;
   }
   // A part holds no triangles of the surface but its own elements' (named_surface.hpp): its
-  // patch names them and gets the rest from the other ranks.
-  if (model.is_part()) set_surface({}, model.mesh);
-  else rebuild(model.mesh);
+  // patch names them and gets the rest from the other ranks. The rigid bodies' surface nodes
+  // are held on every part (never split, so their part nodes stay).
+  if (model.is_part()) {
+    for (const Index whole : model.part.rigid_surface_node) rigid_nodes_.push_back(model.local_node(whole));
+    set_surface({}, model.mesh);
+  } else {
+    rebuild(model.mesh);
+  }
 }
 
 void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip,
@@ -62,6 +67,16 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
     }
     for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of_[n] = root(n);
   }
+  if (model_.is_part()) {
+    // A part names the triangles of its own elements, the bonded faces left out, and each node
+    // by its twin class's whole id (docs/parallel.md "Cracks in contact on parts").
+    bonded_faces_.assign(skip.begin(), skip.end());
+    twin_whole_.clear();
+    for (const Index n : twin_of_) twin_whole_.push_back(model_.whole_node(n));
+    twin_of_ = {};
+    set_surface({}, mesh);
+    return;
+  }
   ContactSurface surface = build_contact_surface(mesh, skip);
   // The shells' control meshes, the mid-surfaces thickened by reach_ (docs/shells.md "Contact");
   // nodes that fracture added (after the shells', of solids) have none.
@@ -75,15 +90,10 @@ void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, in
 }
 
 bool ContactStage::excluded(const ContactPair& p) const {
-  // On several ranks the pair is of patch nodes: their bodies come with them, and the twins
-  // (a whole model only) are a surface vertex's.
+  // On several ranks the pair is of patch nodes: their bodies and twin classes come with them.
   const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
   const auto body = [&](Index n) { return dec_ ? patch_->body(n) : node_body_[n]; };
-  const auto twin = [&](Index n) {
-    if (!dec_) return twin_of_[n];
-    const std::span<const Index> whole = vertices_.whole;
-    return twin_of_[std::lower_bound(whole.begin(), whole.end(), patch_->whole(n)) - whole.begin()];
-  };
+  const auto twin = [&](Index n) { return dec_ ? patch_->twin(n) : twin_of_[n]; };
   if (by_body()) {
     const int a = body(p.nodes[0]), b = body(p.nodes[first]);
     if ((!self_ || shell_body_[a]) && a == b) return true;
@@ -94,7 +104,7 @@ bool ContactStage::excluded(const ContactPair& p) const {
         !std::binary_search(body_pairs_.begin(), body_pairs_.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)}))
       return true;
   }
-  if (twin_of_.empty()) return false;
+  if (!dec_ && twin_of_.empty()) return false;
   for (int i = 0; i < first; ++i)
     for (int j = first; j < 4; ++j)
       if (twin(p.nodes[i]) == twin(p.nodes[j])) return true;
@@ -129,12 +139,21 @@ void ContactStage::set_vertices(const Mesh& mesh) {
   vertices_ = {};
   whole_tables_ = {};
   if (model_.is_part()) {
-    const Model::Part& part = model_.part;
-    vertices_.whole = part.surface_node;
-    vertices_.owner = part.surface_owner;
-    vertices_.body = part.surface_body;
-    for (const Index whole : part.surface_node) vertices_.node.push_back(model_.local_node(whole));
-    SHATTER_ASSERT(std::find(vertices_.node.begin(), vertices_.node.end(), -1) == vertices_.node.end());
+    // The surface nodes it touches, from its mesh, and the rigid bodies' (every part holds
+    // them), merged in whole-id order.
+    const std::vector<Index> touched = touched_surface_nodes(model_, *dec_, bonded());
+    const auto whole = [&](Index n) { return model_.whole_node(n); };
+    for (size_t i = 0, j = 0; i < touched.size() || j < rigid_nodes_.size();) {
+      const bool take_rigid = i == touched.size() || (j < rigid_nodes_.size() && whole(rigid_nodes_[j]) <= whole(touched[i]));
+      const Index n = take_rigid ? rigid_nodes_[j] : touched[i];
+      if (take_rigid && i < touched.size() && touched[i] == n) ++i;
+      vertices_.node.push_back(n);
+      whole_tables_.whole.push_back(whole(n));
+      whole_tables_.owner.push_back(take_rigid ? model_.part.rigid_surface_owner[j] : dec_->node_owner(n));
+      whole_tables_.body.push_back(mesh.node_body[n]);
+      if (!twin_whole_.empty()) whole_tables_.twin.push_back(twin_whole_[n]);
+      take_rigid ? ++j : ++i;
+    }
   } else {
     vertices_.node = surface_.vertices;
     const std::vector<Index> at = vertex_triangles(surface_).position;
@@ -148,16 +167,17 @@ void ContactStage::set_vertices(const Mesh& mesh) {
       whole_tables_.owner.push_back(dec_->node_owner(n));
       whole_tables_.body.push_back(mesh.node_body[n]);
     }
-    vertices_.whole = whole_tables_.whole;
-    vertices_.owner = whole_tables_.owner;
-    vertices_.body = whole_tables_.body;
+    if (!twin_of_.empty())
+      for (const Index n : vertices_.node) whole_tables_.twin.push_back(model_.whole_node(twin_of_[n]));
+    twin_of_ = {};
   }
-  if (!twin_of_.empty()) {
-    std::vector<Index> twin;
-    for (const Index n : vertices_.node) twin.push_back(twin_of_[n]);
-    twin_of_ = std::move(twin);
-  }
+  vertices_.whole = whole_tables_.whole;
+  vertices_.owner = whole_tables_.owner;
+  vertices_.body = whole_tables_.body;
+  vertices_.twin = whole_tables_.twin;
 }
+
+Bonded ContactStage::bonded() const { return {bonded_faces_, twin_whole_}; }
 
 ContactStage::~ContactStage() = default;
 
@@ -252,28 +272,32 @@ NamedTriangle ContactStage::named_triangle(Index t) const {
   const auto& n = surface_.triangles[t];
   const std::span<const Index> whole = vertices_.whole;
   const std::span<const int> owner = vertices_.owner;
+  const auto twin = [&](Index v) { return vertices_.twin.empty() ? whole[v] : vertices_.twin[v]; };
   return {{t, 0, 0},
           {whole[n[0]], whole[n[1]], whole[n[2]]},
           {owner[n[0]], owner[n[1]], owner[n[2]]},
+          {twin(n[0]), twin(n[1]), twin(n[2])},
           surface_.body[t]};
 }
 
 NamedSurface ContactStage::first_owned() const {
-  if (model_.is_part()) return owned_surface(model_, *dec_);
-  // A whole model on ranks (shells, cracks in contact): each primitive by the volume owner
-  // of its first node.
+  if (model_.is_part()) return owned_surface(model_, *dec_, bonded());
+  // A whole model on ranks (shells): each primitive by the volume owner of its first node.
+  const auto twin = [&](Index v) { return vertices_.twin.empty() ? vertices_.whole[v] : vertices_.twin[v]; };
   NamedSurface owned;
   for (Index t = 0; t < surface_.num_triangles(); ++t)
     if (vertices_.owner[surface_.triangles[t][0]] == dec_->rank()) owned.triangles.push_back(named_triangle(t));
   for (const auto& [a, b] : surface_.edges)
     if (vertices_.owner[a] == dec_->rank())
-      owned.edges.push_back(
-          {{vertices_.whole[a], vertices_.whole[b]}, {vertices_.owner[a], vertices_.owner[b]}, vertices_.body[a]});
+      owned.edges.push_back({{vertices_.whole[a], vertices_.whole[b]},
+                             {vertices_.owner[a], vertices_.owner[b]},
+                             {twin(a), twin(b)},
+                             vertices_.body[a]});
   return owned;
 }
 
 std::vector<NamedTriangle> ContactStage::home_triangles() const {
-  if (model_.is_part()) return shatter::home_triangles(model_, *dec_);
+  if (model_.is_part()) return shatter::home_triangles(model_, *dec_, bonded());
   std::vector<NamedTriangle> home;
   const auto mine = [&](Index v) { return vertices_.owner[v] == dec_->rank(); };
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
@@ -382,8 +406,10 @@ long ContactStage::whole_surface_bytes() const {
   auto b = [](const auto& v) { return static_cast<long>(v.capacity() * sizeof(v[0])); };
   return b(surface_.triangles) + b(surface_.body) + b(surface_.edges) + b(surface_.vertices) +
          b(vertex_triangles_.offsets) + b(vertex_triangles_.items) + b(vertex_triangles_.position) +
-         b(whole_tables_.whole) + b(whole_tables_.owner) + b(whole_tables_.body) +
-         (model_.is_part() ? 0 : b(vertices_.node)) + b(node_body_) + b(twin_of_);
+         (model_.is_part() ? 0
+                           : b(whole_tables_.whole) + b(whole_tables_.owner) + b(whole_tables_.body) +
+                                 b(whole_tables_.twin) + b(vertices_.node)) +
+         b(node_body_) + b(twin_of_);
 }
 
 std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<ContactPair>& mine) {
@@ -413,7 +439,9 @@ std::optional<ContactPair> ContactStage::first_unresolved(const std::optional<Co
   std::array<long, 4> gid{};
   for (int c = 0; c < 4; ++c) {
     u.body[c] = static_cast<int>(all[at_first + 5 + c]);
-    const Index n = model_.local_node(first->nodes[c]);
+    const std::span<const Index> held = vertices_.whole;
+    const auto it = std::lower_bound(held.begin(), held.end(), first->nodes[c]);
+    const Index n = it != held.end() && *it == first->nodes[c] ? vertices_.node[it - held.begin()] : -1;
     gid[c] = n >= 0 && dec_->owns_node(n) ? model_.mesh.node_gid[n] : -1;
     u.x[c] = Vec3(all[at_first + 9 + 3 * c], all[at_first + 10 + 3 * c], all[at_first + 11 + 3 * c]);
   }

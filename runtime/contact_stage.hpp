@@ -158,9 +158,11 @@ class ContactStage {
   /// The surface (of `mesh`'s nodes; on a part, empty) and what depends on it: the search
   /// margin, the candidates, the RCB order.
   void set_surface(ContactSurface surface, const Mesh& mesh);
-  /// On several ranks: vertices_ (on a part, the surface vertices it holds), with the surface
-  /// (of mesh node ids on a whole model) turned to surface vertex ids.
+  /// On several ranks: vertices_ (on a part, the surface nodes it touches and the rigid
+  /// bodies'), with the surface (of mesh node ids on a whole model) turned to surface vertex ids.
   void set_vertices(const Mesh& mesh);
+  /// On a part, what fracture changed of its surface (the bonded faces and twins of rebuild()).
+  Bonded bonded() const;
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
   /// Whether the pair (mesh nodes on one rank, patch nodes on several) is left out: its primitives share a node, twins counted as one (rebuild), its
   /// bodies are not a pair of contact.pairs, they are one body and contact.self is false, or
@@ -201,17 +203,22 @@ class ContactStage {
   ContactSurface surface_;
   VertexTriangles vertex_triangles_;  ///< of surface_, for the outward normals DCR orients pairs by
   SurfaceVertices vertices_;          ///< several ranks: the surface vertices held here
-  /// A whole model on several ranks: the tables vertices_ views (a part's are in the part).
+  /// On several ranks: the tables vertices_ views.
   struct {
-    std::vector<Index> whole;
+    std::vector<Index> whole, twin;
     std::vector<int> owner, body;
   } whole_tables_;
+  /// A part: the rigid bodies' surface nodes (part nodes), and what fracture changed of its
+  /// surface (bonded()): the bonded faces, and per node its twin class's whole id (empty: none).
+  std::vector<Index> rigid_nodes_;
+  std::vector<MeshFace> bonded_faces_;
+  std::vector<Index> twin_whole_;
   DcrOptions options_;
   double margin_fraction_ = 0.1;  ///< delta / median surface edge
   double margin_ = 0;
   bool have_candidates_ = false;
   ContactPairs pairs_;          ///< this rank's candidates of the last search (inflated boxes)
-  std::vector<Index> twin_of_;  ///< per surface id, its twins' representative (the smallest node); empty: no twins
+  std::vector<Index> twin_of_;  ///< one rank: per node, its twins' representative (the smallest node); empty: no twins
   std::vector<std::array<int, 2>> body_pairs_;  ///< contact.pairs (empty: all)
   bool self_ = true;                            ///< contact.self
   std::vector<char> free_rigid_;                ///< per body: bodies[i].rigid: free

@@ -167,9 +167,7 @@ void complete_model(Model& m, const RegionSelection& selection);
 
 }  // namespace
 
-bool whole_model_on_every_rank(const Scene& scene) {
-  return (scene.fracture_enabled() && scene.contact) || scene.has_shells();
-}
+bool whole_model_on_every_rank(const Scene& scene) { return scene.has_shells(); }
 
 Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const std::filesystem::path& parts) {
   Model m;
@@ -186,8 +184,8 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
       throw InputError("--parts " + parts.string() + ": part files are for runs on several ranks; expected mpirun -np R "
                        "with the R of `shatter partition --ranks R`, or a run without --parts");
     if (whole_model_on_every_rank(scene))
-      throw InputError(scene.file + ": " + (scene.has_shells() ? "shells hold" : "fracture with contact holds") +
-                       " the whole model on every rank (docs/parallel.md \"Limits\"); expected a run without --parts");
+      throw InputError(scene.file + ": shells hold the whole model on every rank (docs/parallel.md \"Shells on "
+                       "ranks\"); expected a run without --parts");
     const auto t0 = std::chrono::steady_clock::now();
     read_part_file(m, parts, comm);
     mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -197,10 +195,9 @@ Model build_model(const Scene& scene, MPI_Comm comm, double max_elements, const 
     selection = select_regions(scene, m.mesh, groups);
     complete_model(m, selection);
   } else if (whole_model_on_every_rank(scene)) {
-    // Cracks in contact, and shells, still need the whole model on every
-    // rank (docs/parallel.md "Limits", "Shells on ranks"): every rank builds
-    // the shells (each one's Gmsh meshes the same mid-surfaces) after the
-    // solids' nodes.
+    // Shells still need the whole model on every rank (docs/parallel.md
+    // "Shells on ranks"): every rank builds the shells (each one's Gmsh meshes
+    // the same mid-surfaces) after the solids' nodes.
     on_root(comm, [&] { m.mesh = mesh_bodies(scene, max_elements, groups, mesh_seconds); });
     broadcast_mesh(m.mesh, 0, comm);
     m.shells = add_shell_bodies(scene, m.mesh);

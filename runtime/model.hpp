@@ -80,14 +80,14 @@ struct Model {
     std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
     /// Contact scenes: of the whole model's contact surface (build_contact_surface), the
-    /// number of triangles and, per surface vertex the part holds (ascending in whole id),
-    /// its whole id, its volume owner and its body. The triangles are not held: each rank
-    /// names those of its own elements (named_surface.hpp). The part holds the rows of its
-    /// elements' nodes and of the rigid bodies' surface nodes only (docs/parallel.md
-    /// "Patches with their own topology", steps 2 and 4).
+    /// number of triangles, and the rigid bodies' surface nodes (ascending whole ids) with
+    /// their volume owners, which every part holds. The rest is not held: each rank names
+    /// the triangles of its own elements and finds its surface nodes in its mesh
+    /// (named_surface.hpp). The part holds the rows of its elements' nodes and of the rigid
+    /// bodies' surface nodes only (docs/parallel.md "Patches with their own topology").
     Index surface_triangles = 0;
-    std::vector<Index> surface_node;
-    std::vector<int> surface_owner, surface_body;
+    std::vector<Index> rigid_surface_node;
+    std::vector<int> rigid_surface_owner;
     double surface_edge = 0;  ///< the surface's median edge length (median_edge_length)
     Index whole_elements = 0, whole_nodes = 0, whole_bc_nodes = 0;
     std::uint64_t fingerprint = 0;     ///< model_fingerprint() of the whole model
@@ -118,7 +118,7 @@ void for_each_array(M& m, F f) {
   f(m.bc_velocity), f(m.bc_condition), f(m.load_faces), f(m.initial_velocity), f(m.body_mass), f(m.body_volume);
   f(m.part.element_index), f(m.part.node_index), f(m.part.block_color), f(m.part.granule_rank);
   f(m.part.node_rank_offsets), f(m.part.node_ranks), f(m.part.bc_index);
-  f(m.part.surface_node), f(m.part.surface_owner), f(m.part.surface_body);
+  f(m.part.rigid_surface_node), f(m.part.rigid_surface_owner);
 }
 
 /// The model's per-node arrays that node splitting grows, in one order

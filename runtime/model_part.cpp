@@ -28,12 +28,12 @@ struct Partition {
   NodeRanks touch;
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
-  // Contact scenes: the whole model's surface, of which each part holds its nodes' (Model::Part).
+  // Contact scenes: of the whole model's surface (Model::Part), its number of triangles, its
+  // median edge, and the rigid bodies' surface nodes (which every part holds) with their owners.
   Index surface_triangles = 0;
-  std::vector<Index> surface_node;
-  std::vector<int> surface_owner, surface_body;
   double surface_edge = 0;
-  std::vector<Index> rigid_surface_nodes;  ///< the rigid bodies' surface nodes, which every part holds
+  std::vector<Index> rigid_surface_nodes;
+  std::vector<int> rigid_surface_owners;
 };
 
 Partition partition(const Model& whole, int ranks) {
@@ -46,16 +46,14 @@ Partition partition(const Model& whole, int ranks) {
   for (Index n = 0; n < mesh.num_nodes(); ++n)
     if (whole.bc_mask[n]) p.bc_index[n] = p.bc_nodes++;
   if (!whole.scene.contact) return p;
-  // The surface's vertices, and what a part holding one knows of it (cut() keeps a part's).
   const ContactSurface surface = build_contact_surface(mesh);
   p.surface_edge = median_edge_length(surface, mesh.reference);
   p.surface_triangles = surface.num_triangles();
-  p.surface_node = surface.vertices;
-  for (const Index n : surface.vertices) {
-    p.surface_owner.push_back(p.touch.of(n)[0]);
-    p.surface_body.push_back(mesh.node_body[n]);
-    if (whole.scene.bodies[mesh.node_body[n]].has_rigid_state()) p.rigid_surface_nodes.push_back(n);
-  }
+  for (const Index n : surface.vertices)
+    if (whole.scene.bodies[mesh.node_body[n]].has_rigid_state()) {
+      p.rigid_surface_nodes.push_back(n);
+      p.rigid_surface_owners.push_back(p.touch.of(n)[0]);
+    }
   return p;
 }
 
@@ -150,12 +148,8 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   mesh.build_node_elements();
   m.load_faces = held_load_faces(whole.load_faces, part.element_index);
   part.surface_triangles = p.surface_triangles;
-  for (size_t k = 0; k < p.surface_node.size(); ++k)
-    if (local[p.surface_node[k]] >= 0) {
-      part.surface_node.push_back(p.surface_node[k]);
-      part.surface_owner.push_back(p.surface_owner[k]);
-      part.surface_body.push_back(p.surface_body[k]);
-    }
+  part.rigid_surface_node = p.rigid_surface_nodes;
+  part.rigid_surface_owner = p.rigid_surface_owners;
   part.surface_edge = p.surface_edge;
   m.body_mass = whole.body_mass;
   m.body_volume = whole.body_volume;

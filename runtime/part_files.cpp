@@ -19,7 +19,7 @@ namespace shatter {
 namespace {
 
 constexpr std::array<char, 16> kMagic{"shatter parts"};
-constexpr std::uint64_t kVersion = 3;
+constexpr std::uint64_t kVersion = 4;
 
 /// A file written through a running hash; the hash goes last.
 class HashedWriter {
@@ -125,9 +125,6 @@ std::vector<std::uintmax_t> write_part_files(const Model& whole, int ranks, cons
   if (scene.has_shells())
     throw InputError(scene.file + ": shells hold the whole model on every rank (docs/parallel.md \"Shells on ranks\"); "
                                   "expected a scene without shells, or a run that meshes at start-up");
-  if (scene.fracture_enabled() && scene.contact)
-    throw InputError(scene.file + ": fracture with contact holds the whole model on every rank (docs/parallel.md "
-                                  "\"Limits\"); expected a scene without both, or a run that meshes at start-up");
   if (ranks < 2) throw InputError("--ranks " + std::to_string(ranks) + ": expected at least 2 ranks (one rank needs no parts)");
   check_ranks(whole, ranks);
   std::error_code ec;

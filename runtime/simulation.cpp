@@ -369,8 +369,9 @@ void Simulation::apply_fracture() {
   timed(insert_seconds_, insert_cpu_seconds_, [&] {
     dec_->update_nodes(ins.changed_nodes(), fracture_->side_nodes(), kCohesiveSlots, ins.first_cohesive,
                        [&](Index n, std::vector<Index>& out) { fracture_->cohesive_around(n, out); });
-    // After the node lists: the contact patch asks who owns the new nodes.
-    if (contact_ && (freed > 0 || here > 0)) rebuild_contact_surface();
+    // After the node lists: the contact patch asks who owns the new nodes. Every rank
+    // rebuilds (the whole model's counts decide): the re-partition that follows is collective.
+    if (contact_ && (freed > 0 || created > 0)) rebuild_contact_surface();
     share_plans(&ins);
   });
   // The split nodes' masses and forces changed: recompute the accelerations

@@ -15,6 +15,7 @@
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/decomposition.hpp"
+#include "runtime/named_surface.hpp"
 #include "runtime/element_forces.hpp"
 #include "runtime/fracture_stage.hpp"
 #include "runtime/fragment_labels.hpp"
@@ -316,9 +317,9 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
 
 TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   // A contact scene's part holds the rows of its elements' nodes and of the rigid
-  // bodies' surface nodes only; of the whole surface it brings the whole id, volume
-  // owner and body of each vertex it holds, the median edge and the number of triangles,
-  // not the triangles nor the vertices held elsewhere.
+  // bodies' surface nodes only; of the whole surface it brings the rigid bodies' surface
+  // nodes with their volume owners, the median edge and the number of triangles, not the
+  // triangles nor the other vertices.
   const Scene scene = rank_scene(
       "contact_parts",
       "name: contact_parts\ntime: {end: 1.0e-5}\n"
@@ -340,7 +341,7 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   std::vector<char> in_element(part.mesh.num_nodes(), 0);
   for (Index e = 0; e < part.mesh.num_elements(); ++e)
     for (int a = 0; a < part.mesh.nodes_per_element(); ++a) in_element[part.mesh.element(e)[a]] = 1;
-  std::vector<Index> held;
+  std::vector<Index> rigid_held, touched;
   long surface_only_elsewhere = 0;
   for (const Index v : surface.vertices) {
     const Index n = part.local_node(v);
@@ -351,19 +352,17 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
       continue;
     }
     EXPECT_TRUE(in_element[n] || rigid) << "surface node " << v << " held outside the elements";
-    held.push_back(v);
+    if (rigid) rigid_held.push_back(v);
+    if (d.touches(n, d.rank())) touched.push_back(n);
   }
   EXPECT_GT(surface_only_elsewhere, 0) << "every part held every surface node";
-  ASSERT_EQ(p.surface_node, held);
-  ASSERT_EQ(p.surface_owner.size(), held.size());
-  ASSERT_EQ(p.surface_body.size(), held.size());
-  for (size_t k = 0; k < held.size(); ++k) {
-    EXPECT_EQ(p.surface_body[k], whole.mesh.node_body[held[k]]);
-    const Index n = part.local_node(held[k]);
-    if (in_element[n]) {
-      EXPECT_EQ(p.surface_owner[k], d.node_owner(n));
-    }
-  }
+  // The rigid bodies' surface nodes come with the part, with their owners; the part finds the
+  // surface nodes it touches in its own mesh.
+  ASSERT_EQ(p.rigid_surface_node, rigid_held);
+  ASSERT_EQ(p.rigid_surface_owner.size(), rigid_held.size());
+  for (size_t k = 0; k < rigid_held.size(); ++k)
+    EXPECT_EQ(p.rigid_surface_owner[k], d.node_owner(part.local_node(rigid_held[k])));
+  EXPECT_EQ(touched_surface_nodes(part, d), touched);
 }
 
 TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
