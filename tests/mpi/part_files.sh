@@ -80,13 +80,13 @@ cp -r parts_pulled_bar newer
 /usr/bin/python3 - newer/part-0-of-3.bin <<'PY'
 import struct, sys
 data = bytearray(open(sys.argv[1], 'rb').read()[:-8])
-data[16:24] = struct.pack('<Q', 4)
+data[16:24] = struct.pack('<Q', 5)
 h = 1469598103934665603
 for b in data:
     h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
 open(sys.argv[1], 'wb').write(bytes(data) + struct.pack('<Q', h))
 PY
-refused "newer/part-0-of-3.bin: is a part file of version 4; expected version 3" mpi 3 run "$bar" --parts newer --out bad --quiet
+refused "newer/part-0-of-3.bin: is a part file of version 5; expected version 4" mpi 3 run "$bar" --parts newer --out bad --quiet
 head -c 300 /dev/urandom > cut/part-0-of-3.bin
 refused "cut/part-0-of-3.bin: is not a shatter part file" mpi 3 run "$bar" --parts cut --out bad --quiet
 refused "part files are for runs on several ranks" "$shatter" run "$bar" --parts parts_pulled_bar --out bad --quiet
