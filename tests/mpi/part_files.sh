@@ -4,7 +4,8 @@
 # --parts DIR` reads on each rank its own part and meshes nothing. Checks:
 #   - the outputs (history.csv, bodies.csv, fragments.csv) are byte-equal to
 #     the 1-rank run's, for a scene without contact or fracture at 2 and 3
-#     ranks, a contact scene and a fragmenting one at 3, and a run stopped
+#     ranks, a contact scene, a fragmenting one and a fragmenting one with
+#     contact (cracks in contact on parts) at 3, and a run stopped
 #     half way and restarted from its checkpoint, both from part files;
 #   - no rank holds the whole model at start-up: with parts the start-up
 #     rank peaks within 1.15x of the other ranks (without parts, where it
@@ -38,6 +39,7 @@ same_as_one_rank "$scenes/pulled_bar.yaml" 2 history.csv bodies.csv
 same_as_one_rank "$scenes/pulled_bar.yaml" 3 history.csv bodies.csv
 same_as_one_rank "$scenes/five_cubes_friction.yaml" 3 history.csv bodies.csv
 same_as_one_rank "$scenes/expanding_ring.yaml" 3 history.csv bodies.csv fragments.csv
+same_as_one_rank "$scenes/expanding_ring_contact.yaml" 3 history.csv bodies.csv fragments.csv
 # A restart from part files: stopped half way (a checkpoint at step 1000), continued.
 mpi 3 run "$scenes/pulled_bar.yaml" --parts parts_pulled_bar --out restarted --threads 1 --quiet \
   --set time.end=3e-5 --set "checkpoint={every_steps: 1000}"
