@@ -52,31 +52,31 @@ ContactStage::ContactStage(const Model& model, const ContactSpec& spec, const De
 
 void ContactStage::rebuild(const Mesh& mesh, std::span<const std::pair<Index, int>> skip,
                            std::span<const std::array<Index, 2>> twins) {
-  twin_of_.clear();
+  std::vector<Index> twin_of;
   if (!twins.empty()) {
     // Union-find over the twin pairs, each class represented by its smallest node.
-    twin_of_.resize(mesh.num_nodes());
-    std::iota(twin_of_.begin(), twin_of_.end(), 0);
+    twin_of.resize(mesh.num_nodes());
+    std::iota(twin_of.begin(), twin_of.end(), 0);
     auto root = [&](Index n) {
-      while (twin_of_[n] != n) n = twin_of_[n] = twin_of_[twin_of_[n]];
+      while (twin_of[n] != n) n = twin_of[n] = twin_of[twin_of[n]];
       return n;
     };
     for (const auto& [a, b] : twins) {
       const Index ra = root(a), rb = root(b);
-      twin_of_[std::max(ra, rb)] = std::min(ra, rb);
+      twin_of[std::max(ra, rb)] = std::min(ra, rb);
     }
-    for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of_[n] = root(n);
+    for (Index n = 0; n < mesh.num_nodes(); ++n) twin_of[n] = root(n);
   }
   if (model_.is_part()) {
     // A part names the triangles of its own elements, the bonded faces left out, and each node
     // by its twin class's whole id (docs/parallel.md "Cracks in contact on parts").
     bonded_faces_.assign(skip.begin(), skip.end());
     twin_whole_.clear();
-    for (const Index n : twin_of_) twin_whole_.push_back(model_.whole_node(n));
-    twin_of_ = {};
+    for (const Index n : twin_of) twin_whole_.push_back(model_.whole_node(n));
     set_surface({}, mesh);
     return;
   }
+  twin_of_ = std::move(twin_of);
   ContactSurface surface = build_contact_surface(mesh, skip);
   // The shells' control meshes, the mid-surfaces thickened by reach_ (docs/shells.md "Contact");
   // nodes that fracture added (after the shells', of solids) have none.
@@ -169,7 +169,7 @@ void ContactStage::set_vertices(const Mesh& mesh) {
     }
     if (!twin_of_.empty())
       for (const Index n : vertices_.node) whole_tables_.twin.push_back(model_.whole_node(twin_of_[n]));
-    twin_of_ = {};
+    twin_of_ = std::vector<Index>();  // (not `= {}`, which keeps the capacity): the twins travel with the primitives
   }
   vertices_.whole = whole_tables_.whole;
   vertices_.owner = whole_tables_.owner;
