@@ -388,16 +388,24 @@ ContactBalance ContactStage::balance() const {
   const ContactProfile& p = profile_;
   ContactBalance b{p.owned_pairs,     p.owned_pairs, p.owned_pairs,        p.candidates,
                    p.states_posted,   p.state_bytes, p.found_bytes,        p.search_cpu_seconds,
-                   p.sweep_cpu_seconds, whole_surface_bytes(), p.known_vertices_max};
+                   p.sweep_cpu_seconds, whole_surface_bytes(), p.known_vertices_max,
+                   surface_.num_triangles()};
+  // On parts each triangle is owned by one rank (before the first search since the surface
+  // was built, by its first owner); a whole model's count is every rank's.
+  const bool by_owners = model_.is_part();
+  if (by_owners)
+    b.triangles = static_cast<long>(patch_->owned_any() ? owned_.triangles.size() : first_owned().triangles.size());
   if (dec_) {
     long most[6] = {-b.pairs_min,       b.pairs_max,         b.state_bytes_max, b.found_bytes_max,
                     b.whole_surface_bytes_max, b.known_vertices_max},
-         sum[3] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum};
+         sum[4] = {b.pairs_sum, b.candidates_sum, b.states_posted_sum,
+                   by_owners ? b.triangles : 0};
     double cpu[2] = {b.search_cpu_max, b.sweep_cpu_max};
     MPI_Allreduce(MPI_IN_PLACE, most, 6, MPI_LONG, MPI_MAX, dec_->comm());
-    MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_LONG, MPI_SUM, dec_->comm());
+    MPI_Allreduce(MPI_IN_PLACE, sum, 4, MPI_LONG, MPI_SUM, dec_->comm());
     MPI_Allreduce(MPI_IN_PLACE, cpu, 2, MPI_DOUBLE, MPI_MAX, dec_->comm());
-    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4], most[5]};
+    b = {-most[0], most[1], sum[0], sum[1], sum[2], most[2], most[3], cpu[0], cpu[1], most[4], most[5],
+         by_owners ? sum[3] : b.triangles};
   }
   return b;
 }

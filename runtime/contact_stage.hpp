@@ -82,6 +82,7 @@ struct ContactBalance {
   double search_cpu_max = 0, sweep_cpu_max = 0;
   long whole_surface_bytes_max = 0;  ///< ContactStage::whole_surface_bytes
   long known_vertices_max = 0;       ///< ContactProfile::known_vertices_max
+  long triangles = 0;                ///< the whole contact surface's triangles now
 };
 
 class Decomposition;
@@ -124,10 +125,6 @@ class ContactStage {
   /// model, in surface vertex ids (vertex k is the surface's k-th node, surface_nodes()[k]
   /// here); on a part, empty (each rank's patch holds its share).
   const ContactSurface& surface() const { return surface_; }
-  /// The number of triangles of the whole contact surface.
-  Index surface_triangles() const {
-    return model_.is_part() ? model_.part.surface_triangles : surface_.num_triangles();
-  }
   /// The surface's nodes, ascending (mesh node ids; on a part, those it holds).
   std::span<const Index> surface_nodes() const { return dec_ ? vertices_.node : surface_.vertices; }
   /// The candidates of the search in force (on several ranks, this rank's).

@@ -80,12 +80,11 @@ struct Model {
     std::vector<int> node_ranks;
     std::vector<Index> bc_index;       ///< per node with a prescribed component: its rank among the whole model's
     /// Contact scenes: of the whole model's contact surface (build_contact_surface), the
-    /// number of triangles, and the rigid bodies' surface nodes (ascending whole ids) with
-    /// their volume owners, which every part holds. The rest is not held: each rank names
-    /// the triangles of its own elements and finds its surface nodes in its mesh
-    /// (named_surface.hpp). The part holds the rows of its elements' nodes and of the rigid
-    /// bodies' surface nodes only (docs/parallel.md "Patches with their own topology").
-    Index surface_triangles = 0;
+    /// rigid bodies' surface nodes (ascending whole ids) with their volume owners, which
+    /// every part holds. The rest is not held: each rank names the triangles of its own
+    /// elements and finds its surface nodes in its mesh (named_surface.hpp). The part holds
+    /// the rows of its elements' nodes and of the rigid bodies' surface nodes only
+    /// (docs/parallel.md "Patches with their own topology").
     std::vector<Index> rigid_surface_node;
     std::vector<int> rigid_surface_owner;
     double surface_edge = 0;  ///< the surface's median edge length (median_edge_length)

@@ -28,9 +28,8 @@ struct Partition {
   NodeRanks touch;
   std::vector<Index> bc_index;  ///< per node: its rank among the nodes with a prescribed component
   Index bc_nodes = 0;
-  // Contact scenes: of the whole model's surface (Model::Part), its number of triangles, its
-  // median edge, and the rigid bodies' surface nodes (which every part holds) with their owners.
-  Index surface_triangles = 0;
+  // Contact scenes: of the whole model's surface (Model::Part), its median edge, and the rigid
+  // bodies' surface nodes (which every part holds) with their owners.
   double surface_edge = 0;
   std::vector<Index> rigid_surface_nodes;
   std::vector<int> rigid_surface_owners;
@@ -48,7 +47,6 @@ Partition partition(const Model& whole, int ranks) {
   if (!whole.scene.contact) return p;
   const ContactSurface surface = build_contact_surface(mesh);
   p.surface_edge = median_edge_length(surface, mesh.reference);
-  p.surface_triangles = surface.num_triangles();
   for (const Index n : surface.vertices)
     if (whole.scene.bodies[mesh.node_body[n]].has_rigid_state()) {
       p.rigid_surface_nodes.push_back(n);
@@ -147,7 +145,6 @@ Model cut(const Model& whole, const Partition& p, std::vector<Index> elements, s
   }
   mesh.build_node_elements();
   m.load_faces = held_load_faces(whole.load_faces, part.element_index);
-  part.surface_triangles = p.surface_triangles;
   part.rigid_surface_node = p.rigid_surface_nodes;
   part.rigid_surface_owner = p.rigid_surface_owners;
   part.surface_edge = p.surface_edge;
@@ -185,12 +182,11 @@ void cut_parts(const Model& whole, int ranks, const std::function<void(int, Mode
 }
 
 void put_part(const Model& m, const std::function<void(const void*, std::uint64_t)>& put) {
-  const std::uint64_t head[8] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
+  const std::uint64_t head[7] = {static_cast<std::uint64_t>(m.mesh.order), m.mesh.revision,
                                  static_cast<std::uint64_t>(m.part.whole_elements),
                                  static_cast<std::uint64_t>(m.part.whole_nodes),
                                  static_cast<std::uint64_t>(m.part.whole_bc_nodes), m.part.fingerprint,
-                                 std::bit_cast<std::uint64_t>(m.part.surface_edge),
-                                 static_cast<std::uint64_t>(m.part.surface_triangles)};
+                                 std::bit_cast<std::uint64_t>(m.part.surface_edge)};
   put(head, sizeof head);
   for_each_array(m, [&](const auto& v) {
     const std::uint64_t n = v.size();
@@ -200,7 +196,7 @@ void put_part(const Model& m, const std::function<void(const void*, std::uint64_
 }
 
 bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std::uint64_t)>& get) {
-  std::uint64_t head[8];
+  std::uint64_t head[7];
   if (limit < sizeof head) return false;
   get(head, sizeof head);
   limit -= sizeof head;
@@ -211,7 +207,6 @@ bool get_part(Model& m, std::uint64_t limit, const std::function<void(void*, std
   m.part.whole_bc_nodes = static_cast<Index>(head[4]);
   m.part.fingerprint = head[5];
   m.part.surface_edge = std::bit_cast<double>(head[6]);
-  m.part.surface_triangles = static_cast<Index>(head[7]);
   bool fits = true;
   for_each_array(m, [&](auto& v) {
     std::uint64_t n = 0;

@@ -314,7 +314,7 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
     j.add("contact_search_time", contact_->search_seconds());
     j.add("contact_searches", contact_->searches());
     j.add("contact_dcr_time", contact_->dcr_seconds());
-    j.add("contact_surface_triangles", static_cast<long>(contact_->surface_triangles()));
+    j.add("contact_surface_triangles", contact_balance.triangles);
     // The split of the two times above and the work per step (docs/scenes.md).
     const ContactProfile& cp = contact_->profile();
     const double steps = std::max(1L, cp.steps);

@@ -58,6 +58,11 @@ done
 check() { "$mpiexec" -n "$1" --allow-run-as-root --oversubscribe "$shatter" check "$scene" "${extra[@]}" | grep -v '^memory:'; }
 [ "$(check 1)" = "$(check 3)" ] || { echo "FAIL: shatter check on 3 ranks differs from 1 rank:"; check 3; status=1; }
 grep -q '"ranks": 3' "$work/r3t1/summary.json" || { echo "FAIL: r3t1/summary.json does not say 3 ranks"; status=1; }
+# The contact surface's size at the end (crack faces included) is the whole model's on any
+# rank count (on parts, each triangle counted by its one owner).
+tri() { grep -o '"contact_surface_triangles": [0-9]*' "$work/$1/summary.json" | grep -o '[0-9]*$'; }
+[ "$(tri r1t1)" = "$(tri r3t1)" ] ||
+  { echo "FAIL: contact_surface_triangles $(tri r3t1) at 3 ranks, $(tri r1t1) at 1"; status=1; }
 if [ "$kind" = contact ]; then
   col=$(head -1 "$work/r1t1/history.csv" | tr ',' '\n' | grep -n '^contacts$' | cut -d: -f1)
   n=$(tail -n +2 "$work/r1t1/history.csv" | cut -d, -f"$col" | sort -n | tail -1)

@@ -318,8 +318,8 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
 TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   // A contact scene's part holds the rows of its elements' nodes and of the rigid
   // bodies' surface nodes only; of the whole surface it brings the rigid bodies' surface
-  // nodes with their volume owners, the median edge and the number of triangles, not the
-  // triangles nor the other vertices.
+  // nodes with their volume owners and the median edge, not the triangles nor the other
+  // vertices.
   const Scene scene = rank_scene(
       "contact_parts",
       "name: contact_parts\ntime: {end: 1.0e-5}\n"
@@ -336,7 +336,6 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   const ContactSurface surface = build_contact_surface(whole.mesh);
   const Model::Part& p = part.part;
   EXPECT_EQ(p.surface_edge, median_edge_length(surface, whole.mesh.reference));
-  EXPECT_EQ(p.surface_triangles, surface.num_triangles());
   const Decomposition d(part, MPI_COMM_WORLD);
   std::vector<char> in_element(part.mesh.num_nodes(), 0);
   for (Index e = 0; e < part.mesh.num_elements(); ++e)
