@@ -42,8 +42,9 @@
 #          cohesive length"). Under load 10: 5 mm 6-13 min of wall, 4 mm 12-19.
 #          With the Abaqus benchmark's material and load (SIGMA_C=10.45e6
 #          GC=19.58 V=0.06 RAMP=1.96e-4 END=2.5e-3; docs/validation.md "A cited
-#          material"): 0.744-0.748 at 5 mm, 0.72-0.77 at 8 mm (not monotone
-#          there); 8 mm 25-35 s of CPU, 5 mm 86-115 s.
+#          material"): 0.72-0.77 at 8 mm (not monotone there), 0.744-0.748
+#          at 5 mm, 0.70-0.725 at 4 mm (not converged: the 5.6 mm zone is not
+#          resolved); 8 mm 25-35 s of CPU, 5 mm 86-115 s, 4 mm 165-206 s.
 set -euo pipefail
 build=${1:?usage: john_shah_bisect.sh BUILD_DIR [RUN_DIR]}
 runs=${2:-/tmp/john_shah_runs}
