@@ -323,28 +323,22 @@ CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveEleme
   return a;
 }
 
-std::vector<Index> debonded_facets(const Mesh& mesh, const Topology& topo, const CohesiveElements& coh,
-                                   FractureLaws laws, std::span<const Vec3> x, CohesiveShare share) {
-  const int k = mesh.order == 1 ? 3 : 6;
+std::vector<Index> debonded_facets(const Topology& topo, const CohesiveElements& coh, CohesiveShare share) {
   std::vector<Index> out;
   const ShareView which{share, coh.size()};
   for (Index i = 0; i < which.count(); ++i) {
     const Index c = which[i], f = coh.facet[c];
-    if (!which.counted(i) || topo.facet_state[f] != FacetState::cohesive ||
-        !debonded(coh, c, *facet_law(mesh, topo, laws, f)))
-      continue;
-    // Not while the compression penalty holds energy: it would vanish from the ledger.
-    const FacetKinematics fs = facet_kinematics(coh, c, k, x);
-    if (std::all_of(fs.opening.begin(), fs.opening.end(),
-                    [&](const Vec3& o) { return o.dot(fs.area_vector) >= 0; }))
-      out.push_back(f);
+    if (!which.counted(i) || topo.facet_state[f] != FacetState::cohesive) continue;
+    // Every point has come apart (kernels/cohesive.hpp): past delta_c, and
+    // no penalty holds energy that would vanish from the ledger.
+    const double* dm = coh.delta_max.data() + static_cast<size_t>(c) * kCohesivePoints;
+    if (std::all_of(dm, dm + kCohesivePoints, [](double d) { return d == kPointApart; })) out.push_back(f);
   }
   return out;
 }
 
-Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& coh,
-                       FractureLaws laws, std::span<const Vec3> x) {
-  const std::vector<Index> facets = debonded_facets(mesh, topo, coh, laws, x);
+Index release_debonded(Topology& topo, const CohesiveElements& coh) {
+  const std::vector<Index> facets = debonded_facets(topo, coh);
   for (Index f : facets) topo.facet_state[f] = FacetState::free;
   return static_cast<Index>(facets.size());
 }

@@ -154,17 +154,15 @@ struct CrackArea {
 CrackArea crack_area(const Mesh& mesh, const Topology& topo, const CohesiveElements& cohesive,
                      FractureLaws laws, std::span<const Index> elem_fragment, CohesiveShare share = {});
 
-/// Mark free the cohesive facets whose every quadrature point has opened past
-/// delta_c (no traction left; the two sides now belong to separate fragments
-/// unless joined elsewhere) and is not in compression at positions `x` (m),
-/// so that the penalty holds no energy when the facet stops acting
-/// (cohesive_forces). Returns the number of facets freed.
-Index release_debonded(const Mesh& mesh, Topology& topo, const CohesiveElements& cohesive,
-                       FractureLaws laws, std::span<const Vec3> x);
+/// Mark free the cohesive facets whose every quadrature point has come apart
+/// (kPointApart, set by cohesive_forces: opened past delta_c, then not in
+/// compression; no traction and no penalty left, so nothing leaves the
+/// ledger; the two sides now belong to separate fragments unless joined
+/// elsewhere). Returns the number of facets freed.
+Index release_debonded(Topology& topo, const CohesiveElements& cohesive);
 
 /// The facets release_debonded would free among the counted elements of
 /// `share`, ascending in cohesive element order, without freeing them.
-std::vector<Index> debonded_facets(const Mesh& mesh, const Topology& topo, const CohesiveElements& cohesive,
-                                   FractureLaws laws, std::span<const Vec3> x, CohesiveShare share = {});
+std::vector<Index> debonded_facets(const Topology& topo, const CohesiveElements& cohesive, CohesiveShare share = {});
 
 }  // namespace shatter

@@ -55,6 +55,18 @@
 // (runtime/fracture_stage.cpp), as stiff as the adjacent elements, not a
 // user knob. Crack faces that part meet through contact (DCR) once freed.
 //
+// A point comes apart: once it has opened past delta_c and is then not in
+// compression (delta_n >= 0), it exerts nothing from then on, not even the
+// penalty (state delta_max = kPointApart). Its opening may grow to many
+// element sizes while another point of the facet still holds (a chip hanging
+// by a corner), where the mid-surface of the two sides' corners defines no
+// normal: its area fell to 4e-5 of the facet's on the 1e3 /s structured ring,
+// and the penalty's turning-normal force, dphi/dn over that area
+// (cohesive_forces), reached 2e5 sigma_c A and inverted an element
+// (docs/validation.md). It comes apart only while not compressed, so the
+// penalty holds no energy when it stops acting. A facet whose every point
+// has come apart is freed (release_debonded).
+//
 // Energies per unit reference area (J/m^2):
 //   stored     = t_0 delta + K delta^2 / 2 + k_p <-delta_n>^2 / 2
 //                (recoverable: the area under the unloading line, plus the penalty)
@@ -64,6 +76,7 @@
 // where W(delta_max) is the area under the envelope up to delta_max.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "kernels/error.hpp"
 #include "kernels/types.hpp"
@@ -116,6 +129,10 @@ inline double cohesive_stiffness_bound(const CohesiveLaw& law) {
   return std::max(1.0, law.beta * law.beta) * law.penalty;
 }
 
+/// delta_max of a point that has come apart (see the top of this file): it
+/// exerts no traction and no penalty, and has dissipated Gc.
+inline constexpr double kPointApart = std::numeric_limits<double>::infinity();
+
 /// Result of one evaluation of the law at one point of a cohesive surface.
 struct CohesiveTraction {
   Vec3 traction;  ///< T, Pa, acting on side 1 against the opening (side 0 gets -T)
@@ -126,7 +143,7 @@ struct CohesiveTraction {
   /// of this term (cohesive_forces) balances the torque Delta x T = -n x dphi/dn
   /// (phi is invariant under rotations of both).
   Vec3 dphi_dn;
-  double delta_max;   ///< updated state: largest effective opening reached, m
+  double delta_max;   ///< updated state: largest effective opening reached, m, or kPointApart
   double stored;      ///< recoverable energy density, J/m^2
   double dissipated;  ///< dissipated energy density up to delta_max, J/m^2
 };
@@ -143,6 +160,8 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   const double delta = std::sqrt(beta2 * delta_s.squaredNorm() + open_n * open_n);
 
   CohesiveTraction out;
+  if (delta_max == kPointApart)
+    return {Vec3::Zero(), Vec3::Zero(), kPointApart, 0.0, law.fracture_energy()};
   const double dm = std::max(delta, delta_max);
   out.delta_max = dm;
   const double K = cohesive_unloading_stiffness(law, dm);
@@ -164,6 +183,8 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
     c += law.penalty * delta_n;
   }
   out.dphi_dn = c * opening;
+  // Past delta_c and not compressed: no traction (t = 0) and no penalty now, none from now on.
+  if (dm >= law.delta_c && delta_n >= 0) out.delta_max = kPointApart;
   out.dissipated = dm >= law.delta_c ? law.fracture_energy()
                                      : 0.5 * (law.sigma_c / law.delta_c + K) * dm * dm;
   return out;

@@ -209,9 +209,9 @@ double FractureStage::eigenvalue_bound(std::span<const double> mass) {
   return eigenvalue_bound_;
 }
 
-std::vector<Index> FractureStage::debonded(std::span<const Vec3> x) const {
+std::vector<Index> FractureStage::debonded() const {
   if (cohesive_.size() == 0) return {};
-  return debonded_facets(model_.mesh, topology_, cohesive_, laws(), x, mine());
+  return debonded_facets(topology_, cohesive_, mine());
 }
 
 std::vector<std::pair<Index, int>> FractureStage::bonded_faces() const {

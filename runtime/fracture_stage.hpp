@@ -157,10 +157,10 @@ class FractureStage {
   /// 2 / sqrt((2 / element_dt)^2 + lambda_c) (no safety factor).
   double eigenvalue_bound(std::span<const double> mass);
 
-  /// The facets among those owned here that are fully debonded and not in
-  /// compression at positions x (debonded_facets), to free on the ranks
-  /// holding them (Decomposition::share_with_neighbours).
-  std::vector<Index> debonded(std::span<const Vec3> x) const;
+  /// The facets among those owned here whose every point has come apart
+  /// (debonded_facets), to free on the ranks holding them
+  /// (Decomposition::share_with_neighbours).
+  std::vector<Index> debonded() const;
   /// Frees the facets of `gids` held here (debonded() of this rank and of the
   /// ranks around, by global id: at least every one held here); `freed`: how
   /// many the whole model frees.

@@ -328,7 +328,7 @@ void Simulation::apply_fracture() {
   // it, every one of which frees and inserts the facets it holds; the
   // cohesive elements are numbered by their positions among all the ranks'
   // critical facets (key_positions), with no list of the whole model's.
-  const std::vector<GlobalId> debonded = fracture_->gids(fracture_->debonded(x_));
+  const std::vector<GlobalId> debonded = fracture_->gids(fracture_->debonded());
   Index freed = 0;
   std::vector<GlobalId> freed_here;
   timed(comm_seconds_, [&] {

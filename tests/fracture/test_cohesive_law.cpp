@@ -166,6 +166,30 @@ TEST(CohesiveLaw, CompressionActsOnShearOnlyWithNormalPenalty) {
   EXPECT_LT((a - b).norm(), 1e-6 * law.sigma_c);
 }
 
+// A point opened past delta_c comes apart once it is not compressed: pressed
+// shut again it exerts nothing, not even the penalty, and its ledger is Gc.
+// One that slid past delta_c while pressed shut keeps the penalty (its energy
+// must not vanish) until it is out of compression.
+TEST(CohesiveLaw, PointPastDeltaCComesApartOutOfCompression) {
+  const CohesiveLaw law = test_law(1.0);
+  const Vec3 shut = -0.5 * law.delta_c * kNormal;
+  const CohesiveTraction opened = cohesive_traction(law, 1.5 * law.delta_c * kNormal, kNormal, 0.0);
+  EXPECT_EQ(opened.delta_max, kPointApart);
+  EXPECT_EQ(opened.traction, Vec3::Zero());
+  const CohesiveTraction pressed = cohesive_traction(law, shut, kNormal, opened.delta_max);
+  EXPECT_EQ(pressed.traction, Vec3::Zero());
+  EXPECT_EQ(pressed.stored, 0.0);
+  EXPECT_EQ(pressed.delta_max, kPointApart);
+  EXPECT_CLOSE(pressed.dissipated, law.fracture_energy(), 1e-15, 0);
+  // Slid past delta_c while pressed: the penalty holds energy and stays.
+  const CohesiveTraction slid = cohesive_traction(law, shut + 1.5 * law.delta_c * kShear, kNormal, 0.0);
+  EXPECT_CLOSE(slid.delta_max, 1.5 * law.delta_c, 1e-15, 0);
+  EXPECT_GT(slid.stored, 0.0);
+  EXPECT_LT((slid.traction - law.penalty * (-0.5 * law.delta_c) * kNormal).norm(), 1e-12 * law.sigma_c);
+  // Released, it comes apart.
+  EXPECT_EQ(cohesive_traction(law, 1.5 * law.delta_c * kShear, kNormal, slid.delta_max).delta_max, kPointApart);
+}
+
 TEST(CohesiveLaw, LinearPartWithinTheBoundRestBoundedBySigmaC) {
   // The stability argument (kernels/cohesive.hpp): at any state and opening
   // the traction is a part of size at most max(1, beta) sigma_c plus a linear
