@@ -144,7 +144,8 @@ void ContactStage::set_vertices(const Mesh& mesh) {
     const std::vector<Index> touched = touched_surface_nodes(model_, *dec_, bonded());
     const auto whole = [&](Index n) { return model_.whole_node(n); };
     for (size_t i = 0, j = 0; i < touched.size() || j < rigid_nodes_.size();) {
-      const bool take_rigid = i == touched.size() || (j < rigid_nodes_.size() && whole(rigid_nodes_[j]) <= whole(touched[i]));
+      const bool take_rigid =
+          i == touched.size() || (j < rigid_nodes_.size() && whole(rigid_nodes_[j]) <= whole(touched[i]));
       const Index n = take_rigid ? rigid_nodes_[j] : touched[i];
       if (take_rigid && i < touched.size() && touched[i] == n) ++i;
       vertices_.node.push_back(n);

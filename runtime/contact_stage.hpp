@@ -161,9 +161,9 @@ class ContactStage {
   /// On a part, what fracture changed of its surface (the bonded faces and twins of rebuild()).
   Bonded bonded() const;
   bool candidates_valid(std::span<const Vec3> x_old, std::span<const Vec3> x_new) const;
-  /// Whether the pair (mesh nodes on one rank, patch nodes on several) is left out: its primitives share a node, twins counted as one (rebuild), its
-  /// bodies are not a pair of contact.pairs, they are one body and contact.self is false, or
-  /// both are free rigid bodies.
+  /// Whether the pair (mesh nodes on one rank, patch nodes on several) is left out: its
+  /// primitives share a node, twins counted as one (rebuild), its bodies are not a pair of
+  /// contact.pairs, they are one body and contact.self is false, or both are free rigid bodies.
   bool excluded(const ContactPair& p) const;
   /// Whether excluded() reads the pairs' bodies.
   bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }

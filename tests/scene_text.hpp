@@ -18,6 +18,19 @@ inline std::string write_scene(const std::string& name, const std::string& yaml)
   return path.string();
 }
 
+/// The fragmenting rings' aluminium (scenes/expanding_ring.yaml) as the `materials:` block of
+/// one material `alu`; `fracture_extra` is appended inside its fracture map (", scatter: ...").
+inline std::string ring_aluminium(const std::string& fracture_extra = "") {
+  return "materials:\n"
+         "  alu:\n"
+         "    model: neo_hookean\n"
+         "    density: 2750\n"
+         "    youngs_modulus: 275.0e9\n"
+         "    poisson_ratio: 0.3\n"
+         "    fracture: {strength: 300.0e6, energy: 100.0, beta: 1.0" +
+         fracture_extra + "}\n";
+}
+
 /// A scene of one steel body named b, run to `end` s, its mesh given by
 /// `mesh` (the inside of mesh: {...}); `body` lines (indented by four
 /// spaces) are added to the body, `extra` lines at the top level.

@@ -19,14 +19,8 @@ namespace {
 
 const std::string kRing =
     "name: ring\n"
-    "time: {end: 1.0}\n"
-    "materials:\n"
-    "  alu:\n"
-    "    model: neo_hookean\n"
-    "    density: 2750\n"
-    "    youngs_modulus: 275.0e9\n"
-    "    poisson_ratio: 0.3\n"
-    "    fracture: {strength: 300.0e6, energy: 100.0, beta: 1.0}\n"
+    "time: {end: 1.0}\n" +
+    shatter::test::ring_aluminium() +
     "bodies:\n"
     "  - name: ring\n"
     "    material: alu\n"

@@ -52,17 +52,8 @@ std::string ring_mesh(int cells_around) {
 
 std::string ring_scene(const std::string& mesh, int seed) {
   return "name: structured_ring\n"
-         "time: {end: 8.0e-7}\n"
-         "materials:\n"
-         "  alu:\n"
-         "    model: neo_hookean\n"
-         "    density: 2750\n"
-         "    youngs_modulus: 275.0e9\n"
-         "    poisson_ratio: 0.3\n"
-         "    fracture: {strength: 300.0e6, energy: 100.0, beta: 1.0,\n"
-         "               scatter: {distribution: uniform, spread: 0.05, seed: " +
-         std::to_string(seed) +
-         "}}\n"
+         "time: {end: 8.0e-7}\n" +
+         test::ring_aluminium(", scatter: {distribution: uniform, spread: 0.05, seed: " + std::to_string(seed) + "}") +
          "bodies:\n"
          "  - name: ring\n"
          "    material: alu\n"
