@@ -10,17 +10,18 @@ namespace shatter {
 
 namespace {
 
-/// Every boundary triangle of the part's mesh, named, in name order (local elements ascend in
-/// whole id). Faces the part misclassifies (of outer ghosts, whose
-/// neighbours it lacks) hold no node of an owned element.
-/// Their nodes' owners are right for the triangles of the elements sharing a node with an owned
-/// one (the first ghost layer's ranks are the start-up rank's, or whole stars with two layers),
-/// which are all that leave here (-1: a node no rank touches).
+/// A boundary triangle of the part's mesh, named, with its nodes in the part.
 struct PartTriangle {
   NamedTriangle named;
   std::array<Index, 3> local;  ///< its nodes in the part
 };
 
+/// Every boundary triangle of the part's mesh, the bonded faces left out, in name order (local
+/// elements ascend in whole id). Faces the part misclassifies (of outer ghosts, whose
+/// neighbours it lacks) hold no node of an owned element. Their nodes' owners are right for
+/// the triangles of the elements sharing a node with an owned one (the first ghost layer's
+/// ranks are the start-up rank's, or whole stars with two layers), which are all that leave
+/// here (-1: a node no rank touches).
 std::vector<PartTriangle> part_boundary(const Model& model, const Decomposition& dec, const Bonded& bonded) {
   const Mesh& mesh = model.mesh;
   const auto owner = [&](Index n) { return dec.distributed() && dec.node_ranks(n).empty() ? -1 : dec.node_owner(n); };
