@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <numeric>
 #include <utility>
 
 #include "kernels/error.hpp"
@@ -22,7 +23,7 @@ namespace {
 /// Facets per call of facet_traction_lanes: one AVX-512 vector, two AVX ones.
 constexpr int kFacetLanes = 8;
 /// Facets screened at a time before their tractions are evaluated.
-constexpr Index kFacetChunk = 1024;
+constexpr Index kFacetChunk = 256;
 
 /// Whether any of the kFacetLanes flags is set, tested as one word.
 bool any_lane(const bool (&flag)[kFacetLanes]) {
@@ -150,7 +151,7 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
   const Index nf = topo.num_facets();
   tbb::parallel_for(tbb::blocked_range<Index>(0, nf, kFacetChunk), [&](const tbb::blocked_range<Index>& r) {
     std::vector<Index>* local_found = nullptr;
-    Index candidate[kFacetChunk], corner_node[3][kFacetChunk], side[2][kFacetChunk];
+    Index candidate[kFacetChunk], side[2][kFacetChunk], broken_facet[kFacetChunk];
     for (Index f0 = r.begin(); f0 < r.end(); f0 += kFacetChunk) {
       const Index f1 = std::min<Index>(f0 + kFacetChunk, r.end());
       int count = 0;
@@ -166,45 +167,50 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
         side[1][count] = e1_or_e0;
         count += keep;
       }
-      // Their corners (the conn rows of the elements 0, in order), then the
-      // tractions kFacetLanes at a time.
+      // Element 1's stress row is the one load of the evaluation out of
+      // order (the facets follow their elements 0): ask for the rows now, so
+      // that their misses overlap here rather than stall the lanes' filling.
       for (int k = 0; k < count; ++k) {
-        const Index* corner = mesh.element(side[0][k]);
-        const std::array<int, 6>& face = kTetFaces[topo.facet_face[candidate[k]][0]];
-        for (int a = 0; a < 3; ++a) corner_node[a][k] = corner[face[a]];
-        // Element 1's stress row is the one load of the evaluation out of
-        // order (the facets follow their elements 0): ask for it now, so
-        // that its misses overlap here rather than stall the lanes' gathers.
         const double* row = stress.data() + static_cast<size_t>(side[1][k]) * stress_size;
         __builtin_prefetch(row);
         __builtin_prefetch(row + stress_size - 1);
       }
+      int nbroken = 0;  // the facets found in the chunk: broken_facet[0, nbroken)
       auto evaluate = [&]<int S>() {
+        // The kept facets side by side (lane k = candidate k), filled facet by
+        // facet; each group of kFacetLanes then loads its rows as vectors,
+        // with no transposition (the stores have long left when they are read).
+        // One group of lanes more than the chunk: rows a power of two apart
+        // would share the L1 sets (4 KiB apart) and evict each other.
+        FacetTractionLanes<kFacetChunk + kFacetLanes, S> chunk;
+        double chunk_strength[kFacetChunk];
+        const int padded = (count + kFacetLanes - 1) / kFacetLanes * kFacetLanes;
+        for (int j = 0; j < padded; ++j) {
+          const int k = std::min(j, count - 1);  // lanes past the last repeat it
+          const Index* corner = mesh.element(side[0][k]);  // the conn rows of the elements 0, in order
+          const std::array<int, 6>& face = kTetFaces[topo.facet_face[candidate[k]][0]];
+          for (int a = 0; a < 3; ++a) {
+            const double* p = x[corner[face[a]]].data();
+            for (int c = 0; c < 3; ++c) chunk.x[3 * a + c][j] = p[c];
+          }
+          const double* s0 = stress.data() + static_cast<size_t>(side[0][k]) * S;
+          const double* s1 = stress.data() + static_cast<size_t>(side[1][k]) * S;
+          for (int q = 0; q < S; ++q) chunk.stress_sum[q][j] = s0[q] + s1[q];
+          const CohesiveLaw& law = *laws.material[mat[side[0][k]]];  // facet_law's
+          chunk.beta[j] = law.beta;
+          chunk_strength[j] = laws.facet_strength.empty() ? law.sigma_c : laws.facet_strength[candidate[k]];
+        }
         for (int k0 = 0; k0 < count; k0 += kFacetLanes) {
           const int lanes = std::min(kFacetLanes, count - k0);
           FacetTractionLanes<kFacetLanes, S> L;
           double strength[kFacetLanes];
-          const double* corner_x[3][kFacetLanes];
-          double stress_sum[kFacetLanes][S];  // a facet's sum per row: added as the rows lie in memory
-          for (int l = 0; l < kFacetLanes; ++l) {
-            const int k = k0 + std::min(l, lanes - 1);  // lanes past the last repeat it
-            for (int a = 0; a < 3; ++a) corner_x[a][l] = x[corner_node[a][k]].data();
-            const double* s0 = stress.data() + static_cast<size_t>(side[0][k]) * S;
-            const double* s1 = stress.data() + static_cast<size_t>(side[1][k]) * S;
-            for (int q = 0; q < S; ++q) stress_sum[l][q] = s0[q] + s1[q];
-            const CohesiveLaw& law = *laws.material[mat[side[0][k]]];  // facet_law's
-            L.beta[l] = law.beta;
-            strength[l] = laws.facet_strength.empty() ? law.sigma_c : laws.facet_strength[candidate[k]];
-          }
-          // Lane index innermost: each row is one vector store.
-          for (int a = 0; a < 3; ++a)
-            for (int c = 0; c < 3; ++c)
-              for (int l = 0; l < kFacetLanes; ++l) L.x[3 * a + c][l] = corner_x[a][l][c];
-          for (int q = 0; q < S; ++q)
-            for (int l = 0; l < kFacetLanes; ++l) L.stress_sum[q][l] = stress_sum[l][q];
+          for (int r = 0; r < 9; ++r) std::copy_n(chunk.x[r] + k0, kFacetLanes, L.x[r]);
+          for (int q = 0; q < S; ++q) std::copy_n(chunk.stress_sum[q] + k0, kFacetLanes, L.stress_sum[q]);
+          std::copy_n(chunk.beta + k0, kFacetLanes, L.beta);
+          std::copy_n(chunk_strength + k0, kFacetLanes, strength);
           // The decisions without division or square root; the tractions
           // themselves only where the margin leaves a lane undecided (rare:
-          // t_eff within ~1e-10 of the strength). Lanes past the last repeat it.
+          // t_eff within ~1e-10 of the strength).
           bool broken[kFacetLanes], undecided[kFacetLanes];
           facet_criterion_lanes(L, strength, broken, undecided);
           if (any_lane(undecided)) {
@@ -212,20 +218,25 @@ std::vector<Index> critical_facets(const Mesh& mesh, const Topology& topo, std::
             for (int l = 0; l < kFacetLanes; ++l) broken[l] = L.traction[l] >= strength[l];
           }
           if (!any_lane(broken)) continue;  // few break
-          for (int l = 0; l < lanes; ++l)
-            if (broken[l]) {
-              if (!local_found) local_found = &found.local();
-              local_found->push_back(candidate[k0 + l]);
-            }
+          for (int l = 0; l < lanes; ++l) {  // without branches: which lanes break is unpredictable
+            broken_facet[nbroken] = candidate[k0 + l];
+            nbroken += broken[l];
+          }
         }
       };
       if (stress_size == 6)
         evaluate.template operator()<6>();
       else
         evaluate.template operator()<9>();
+      if (nbroken > 0) {
+        if (!local_found) local_found = &found.local();
+        local_found->insert(local_found->end(), broken_facet, broken_facet + nbroken);
+      }
     }
   });
   std::vector<std::pair<GlobalId, Index>> keyed;
+  keyed.reserve(std::accumulate(found.begin(), found.end(), size_t{0},
+                                [](size_t n, const std::vector<Index>& v) { return n + v.size(); }));
   for (const std::vector<Index>& v : found)
     for (Index f : v) keyed.emplace_back(topo.facet_gid[f], f);
   sort_by_key(keyed);  // global ids are distinct: one order
