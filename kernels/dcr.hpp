@@ -416,6 +416,8 @@ inline double dcr_inside_margin(DcrPairKind kind, const PairPoints& X) {
 ///    another body's bottom face, meets that body's side face exactly on its edge);
 ///  - for two edges, when they still cross at X_new (an edge's end point sliding over
 ///    another edge in the plane of its face crosses it only at that instant).
+/// Inside a triangle too, a vertex crossing counts only when its outward normal does not
+/// lean to the face's outer side (n_vertex . n_face <= 0; a zero normal, a sheet's, passes).
 /// Robust for fast motion (exact cubic in t, no sampling), grazing (g touches 0 and
 /// returns: g(X_new) > -tol), touching at the end (|g| <= tol), touching at the start
 /// (coincident faces) and degenerate geometry.
@@ -474,14 +476,20 @@ inline DcrPenetration dcr_detect(DcrPairKind kind, const PairPoints& X_old, cons
   const double margin =
       dcr_inside_margin(kind, touching ? X_new : PairPoints(X_old + t_star * (X_new - X_old)));
   if (!(margin >= -kDcrInsideTolerance)) return out;
-  if (touching || margin <= kDcrInsideTolerance) {
-    if (kind == DcrPairKind::VertexFace) {
-      const Vec3 n_face = (X_old.col(2) - X_old.col(1)).cross(X_old.col(3) - X_old.col(1));
-      const Vec3 n_vertex = pair_normals().col(0);
-      if (n_vertex.dot(n_face) > -kDcrFacingTolerance * n_vertex.norm() * n_face.norm()) return out;
-    } else if (!(dcr_inside_margin(kind, X_new) >= -kDcrInsideTolerance)) {
-      return out;
-    }
+  const bool on_boundary = touching || margin <= kDcrInsideTolerance;
+  if (kind == DcrPairKind::VertexFace) {
+    // A vertex arriving from outside has its body on the face's outer side, so its outward
+    // normal does not lean to that side (unless its normal cone is wider than 90 degrees: a
+    // blade's tip, left to its edges' pairs). One that leans came in from the side: a copy
+    // of a crack-front node lying in the coplanar face of the piece across the crack, whose
+    // pair and its mirror image pushed each other to the sweep cap (docs/contact.md
+    // "Crack-front copies"). On the boundary the vertex must face the triangle (issue 7).
+    const Vec3 n_face = (X_old.col(2) - X_old.col(1)).cross(X_old.col(3) - X_old.col(1));
+    const Vec3 n_vertex = pair_normals().col(0);
+    const double facing = on_boundary ? -kDcrFacingTolerance * n_vertex.norm() * n_face.norm() : 0.0;
+    if (n_vertex.dot(n_face) > facing) return out;
+  } else if (on_boundary && !(dcr_inside_margin(kind, X_new) >= -kDcrInsideTolerance)) {
+    return out;
   }
   out.penetrating = true;
   out.time = t_star;

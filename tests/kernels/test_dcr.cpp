@@ -326,6 +326,26 @@ TEST(DcrDetect, VertexOnTheEdgeOfASlidingFaceIsAGraze) {
   }
 }
 
+// Two pieces of a cracked plate side by side, their top faces coplanar (z = 0): the copies of a
+// crack-front node, one on each piece, drift microns apart, so that each lies inside the
+// other's top face near its corner and crosses its plane as the faces jitter (the glass plate,
+// docs/contact.md "Crack-front copies"). The vertex's outward normal (its top face's +z plus
+// its crack face's, here -x) leans to the face's outer side: it came in from the side, no
+// penetration (these pairs and their mirror images pushed each other to the sweep cap). A
+// vertex whose normal does not lean so (one arriving from above, facing down or sideways) and
+// one without normals (a sheet's two sides cancel) are caught as before.
+TEST(DcrDetect, CrackFrontCopyInTheCoplanarFaceAcrossTheCrackIsNotAPenetration) {
+  const Vec3 corner_copy(5e-3, 6e-3, 0);
+  const PairPoints Xo = points(corner_copy + Vec3(0, 0, 1e-6), kA, kB, kC);
+  const PairPoints Xn = points(corner_copy - Vec3(0, 0, 1e-6), kA, kB, kC);
+  EXPECT_FALSE(dcr_detect(VF, Xo, Xn, normals(Vec3(-1, 0, 1))).penetrating);
+  EXPECT_FALSE(dcr_detect(VF, Xo, Xn, normals(Vec3(-1, 0, 1e-3))).penetrating);
+  for (const Vec3& n : {Vec3(0, 0, -1), Vec3(-1, 0, -1), Vec3(-1, 0, 0), Vec3(0, 0, 0)}) {
+    SCOPED_TRACE(n.transpose());
+    EXPECT_TRUE(dcr_detect(VF, Xo, Xn, normals(n)).penetrating);
+  }
+}
+
 // Grazing along a face (issue 7): the end point of an edge (the lower end of a vertical edge
 // of a body sliding along a face) passes over an edge of that face, in its plane. The lines
 // cross, the segments touch at one instant: no penetration. So does a vertical edge whose
