@@ -2,9 +2,33 @@
 
 #include <zoltan.h>
 
+#include <algorithm>
+#include <map>
+
 #include "kernels/error.hpp"
 
 namespace shatter {
+
+std::vector<int> align_parts(int parts, std::vector<std::array<long, 3>> overlap) {
+  std::sort(overlap.begin(), overlap.end());
+  std::vector<std::array<long, 3>> summed;
+  for (const auto& o : overlap)
+    if (!summed.empty() && summed.back()[0] == o[0] && summed.back()[1] == o[1])
+      summed.back()[2] += o[2];
+    else
+      summed.push_back(o);
+  std::stable_sort(summed.begin(), summed.end(), [](const auto& a, const auto& b) { return a[2] > b[2]; });
+  std::vector<int> rank_of(parts, -1);
+  std::vector<char> taken(parts, 0);
+  for (const auto& [part, home, count] : summed)
+    if (rank_of[part] < 0 && !taken[home]) rank_of[part] = static_cast<int>(home), taken[home] = 1;
+  for (int p = 0, r = 0; p < parts; ++p) {
+    if (rank_of[p] >= 0) continue;
+    while (taken[r]) ++r;
+    rank_of[p] = r, taken[r] = 1;
+  }
+  return rank_of;
+}
 
 ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   MPI_Comm_rank(comm, &rank_);
@@ -15,7 +39,7 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
   SHATTER_REQUIRE(zz_, "Zoltan_Create failed");
   for (const auto& [key, value] : {std::pair{"DEBUG_LEVEL", "0"}, {"LB_METHOD", "RCB"}, {"NUM_GID_ENTRIES", "4"}, {"NUM_LID_ENTRIES", "1"},
                                    {"OBJ_WEIGHT_DIM", "2"}, {"RETURN_LISTS", "EXPORT"},
-                                   {"RCB_REUSE", "0"}, {"KEEP_CUTS", "0"}, {"IMBALANCE_TOL", "1.02"}})
+                                   {"RCB_REUSE", "0"}, {"KEEP_CUTS", "0"}, {"REMAP", "0"}, {"IMBALANCE_TOL", "1.02"}})
     Zoltan_Set_Param(zz_, key, value);
   Zoltan_Set_Num_Obj_Fn(
       zz_, [](void* data, int* ierr) -> int {
@@ -56,10 +80,11 @@ ContactPartition::ContactPartition(MPI_Comm comm) : comm_(comm) {
 ContactPartition::~ContactPartition() { Zoltan_Destroy(&zz_); }
 
 std::vector<int> ContactPartition::partition(std::span<const Index> names, std::span<const Vec3> points,
-                                             std::span<const float> weights) {
-  SHATTER_REQUIRE(names.size() == kNameWords * points.size() && 2 * points.size() == weights.size(),
+                                             std::span<const float> weights, std::span<const int> homes) {
+  SHATTER_REQUIRE(names.size() == kNameWords * points.size() && 2 * points.size() == weights.size() &&
+                      homes.size() == points.size(),
                   "ContactPartition: " << names.size() << " name words, " << points.size() << " points, "
-                                       << weights.size() << " weights");
+                                       << weights.size() << " weights, " << homes.size() << " homes");
   names_ = names;
   points_ = points;
   weights_ = weights;
@@ -76,6 +101,21 @@ std::vector<int> ContactPartition::partition(std::span<const Index> names, std::
   Zoltan_LB_Free_Part(&export_gids, &export_lids, &export_procs, &export_parts);
   // Every rank gets the same return code: Zoltan's calls are collective.
   SHATTER_REQUIRE(rc == ZOLTAN_OK, "Zoltan_LB_Partition (RCB) failed with code " << rc);
+  // Zoltan numbers the parts; each goes to the rank where most of its objects are at home.
+  std::map<std::pair<int, int>, long> mine;
+  for (size_t k = 0; k < to.size(); ++k) ++mine[{to[k], homes[k]}];
+  std::vector<long> words;
+  for (const auto& [key, count] : mine) words.insert(words.end(), {key.first, key.second, count});
+  int count = static_cast<int>(words.size());
+  std::vector<int> counts(size_), offsets(size_ + 1, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int r = 0; r < size_; ++r) offsets[r + 1] = offsets[r] + counts[r];
+  std::vector<long> all(offsets[size_]);
+  MPI_Allgatherv(words.data(), count, MPI_LONG, all.data(), counts.data(), offsets.data(), MPI_LONG, comm_);
+  std::vector<std::array<long, 3>> overlap(all.size() / 3);
+  for (size_t k = 0; k < overlap.size(); ++k) overlap[k] = {all[3 * k], all[3 * k + 1], all[3 * k + 2]};
+  const std::vector<int> rank_of = align_parts(size_, std::move(overlap));
+  for (int& r : to) r = rank_of[r];
   return to;
 }
 

@@ -6,6 +6,7 @@
 // do not depend on the partition: it decides the load balance, never the bits.
 #include <mpi.h>
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -14,6 +15,13 @@
 struct Zoltan_Struct;
 
 namespace shatter {
+
+/// The numbering of `parts` parts onto as many ranks that keeps the most objects at home:
+/// overlap lists (part, home rank, objects) entries, summed over the ranks; entries are
+/// taken by decreasing count (ties by part, then rank) while both are free, and the parts
+/// left go to the ranks left in ascending order. Returns the rank of each part. The same
+/// on every rank given the same entries, in any order.
+std::vector<int> align_parts(int parts, std::vector<std::array<long, 3>> overlap);
 
 class ContactPartition {
  public:
@@ -30,8 +38,12 @@ class ContactPartition {
   /// kNameWords numbers >= 0 each (distinct over the ranks), with their points and two
   /// weights each (>= 0, object-major), balanced together (Zoltan's multi-criteria RCB).
   /// Only Zoltan's export lists are read: no list of every object's part goes to every rank.
+  /// homes: per object, the rank whose volume part holds most of its nodes. RCB's parts are
+  /// numbered so that as many objects as possible land on their home (align_parts): the part
+  /// numbers are Zoltan's choice, and a part handed to the wrong rank would make that rank
+  /// fetch the states of nearly every node it detects for.
   std::vector<int> partition(std::span<const Index> names, std::span<const Vec3> points,
-                             std::span<const float> weights);
+                             std::span<const float> weights, std::span<const int> homes);
 
  private:
   MPI_Comm comm_;

@@ -328,7 +328,14 @@ void ContactStage::partition() {
     points.push_back(0.5 * (x[n[0]] + x[n[1]]));
   }
   for (const float w : weight_) weights.insert(weights.end(), {1.0f, 0.01f + w});
-  const std::vector<int> to = partition_->partition(names, points, weights);
+  // Each primitive's home: the volume owner of most of its nodes (of its first node on a tie).
+  std::vector<int> homes;
+  for (const NamedTriangle& t : owned_.triangles) {
+    const auto& o = t.owner;
+    homes.push_back(o[1] == o[2] && o[1] != o[0] ? o[1] : o[0]);
+  }
+  for (const NamedEdge& e : owned_.edges) homes.push_back(e.owner[0]);
+  const std::vector<int> to = partition_->partition(names, points, weights, homes);
   // The primitives that leave go to their new ranks with their data (kind 0 and a triangle's
   // words, or kind 1 and an edge's: append_words).
   const int me = dec_->rank();
