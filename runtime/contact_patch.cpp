@@ -105,7 +105,13 @@ Index ContactPatch::node(Index whole) const {
 }
 
 void ContactPatch::sort_by_whole(std::vector<Index>& nodes) const {
-  std::sort(nodes.begin(), nodes.end(), [&](Index a, Index b) { return known_[a].whole < known_[b].whole; });
+  // As one 64-bit key each (whole id, then the known index): a sort with no look-up in its
+  // comparisons (the look-ups made the sorts of reach() and activate() a third of their time).
+  std::vector<std::uint64_t> keys(nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i)
+    keys[i] = static_cast<std::uint64_t>(known_[nodes[i]].whole) << 32 | static_cast<std::uint32_t>(nodes[i]);
+  std::sort(keys.begin(), keys.end());
+  for (size_t i = 0; i < nodes.size(); ++i) nodes[i] = static_cast<Index>(keys[i] & 0xffffffffu);
 }
 
 Index ContactPatch::owned_primitive(Index q) const {
@@ -348,8 +354,10 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (size_t k = 0, count = needed.size(); k < count; ++k)
     for (const Index t : ring_of(needed[k]))
       if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
-  for (const Index t : triangles) ring_mark_[t] = 0;
-  std::sort(triangles.begin(), triangles.end(), [&](Index a, Index b) { return ring_keys_[a] < ring_keys_[b]; });
+  std::vector<std::pair<std::int64_t, Index>> keyed(triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) ring_mark_[triangles[i]] = 0, keyed[i] = {ring_keys_[triangles[i]], triangles[i]};
+  std::sort(keyed.begin(), keyed.end());
+  for (size_t i = 0; i < triangles.size(); ++i) triangles[i] = keyed[i].second;
   for (const Index t : triangles)
     for (const Index n : ring_.triangles[t]) add_node(n, needed);
   sort_marked(needed);
