@@ -224,11 +224,6 @@ void ContactPatch::add_node(Index n, std::vector<Index>& nodes) {
   if (!known_[n].mark) known_[n].mark = true, nodes.push_back(n);
 }
 
-void ContactPatch::sort_marked(std::vector<Index>& nodes) {
-  for (const Index n : nodes) known_[n].mark = false;
-  sort_by_whole(nodes);
-}
-
 void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin) {
   const int ranks = dec_.size(), me = dec_.rank();
   owned_boxes_ = inflated_boxes(owned_, x_old_, x_new_, margin, reach_);
@@ -345,22 +340,30 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
   // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'); surface
-  // vertex ids.
-  std::vector<Index> needed, triangles;
+  // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'), marked by
+  // patch node: the patch numbering ascends with the whole ids, so the marked nodes read in
+  // order are sorted by whole id.
+  std::vector<std::uint8_t> at(nodes_.size(), 0);
   for (const ContactPair& p : pairs)
-    for (const Index k : p.nodes) add_node(nodes_[k], needed);
+    for (const Index k : p.nodes) at[k] = 1;
+  std::vector<Index> triangles;
   ring_mark_.resize(ring_.triangles.size(), 0);
-  for (size_t k = 0, count = needed.size(); k < count; ++k)
-    for (const Index t : ring_of(needed[k]))
-      if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
+  for (size_t k = 0; k < at.size(); ++k)
+    if (at[k])
+      for (const Index t : ring_of(nodes_[k]))
+        if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
   std::vector<std::pair<std::int64_t, Index>> keyed(triangles.size());
   for (size_t i = 0; i < triangles.size(); ++i) ring_mark_[triangles[i]] = 0, keyed[i] = {ring_keys_[triangles[i]], triangles[i]};
   std::sort(keyed.begin(), keyed.end());
   for (size_t i = 0; i < triangles.size(); ++i) triangles[i] = keyed[i].second;
   for (const Index t : triangles)
-    for (const Index n : ring_.triangles[t]) add_node(n, needed);
-  sort_marked(needed);
+    for (const Index n : ring_.triangles[t]) {
+      SHATTER_ASSERT(known_[n].position >= 0);
+      at[known_[n].position] = 1;
+    }
+  std::vector<Index> needed;
+  for (size_t k = 0; k < at.size(); ++k)
+    if (at[k]) needed.push_back(nodes_[k]);
   // reach() holds the rings' nodes in the patch. Only the triangles, their vertices and the
   // vertex -> triangle lists are made (surface_normal's needs).
   normals_ = {};
@@ -488,20 +491,21 @@ void ContactPatch::find_readers(const PlanLists& lists) {
   for (const auto* plan : {&lists.send, &lists.receive})
     for (const auto& [r, list] : *plan) neighbors_.push_back(r);
   sort_unique(neighbors_);
-  // Each home node's readers: the ranks it is sent to, and the other ranks touching it.
+  // Each home node's readers: the ranks it is sent to, and the other ranks touching it, as
+  // (home node, rank) entries sorted into the CSR.
   const auto& home = volume_vertices_.vertices;
-  std::vector<std::vector<int>> readers(home.size());
+  std::vector<std::pair<Index, int>> entries;
   for (const auto& [r, list] : lists.send)
-    for (const Index n : list) readers[std::lower_bound(home.begin(), home.end(), n) - home.begin()].push_back(r);
-  reader_offsets_.assign(1, 0);
-  readers_.clear();
-  for (size_t k = 0; k < home.size(); ++k) {
+    for (const Index n : list)
+      entries.push_back({static_cast<Index>(std::lower_bound(home.begin(), home.end(), n) - home.begin()), r});
+  for (size_t k = 0; k < home.size(); ++k)
     for (const int r : dec_.node_ranks(home[k]))
-      if (r != me) readers[k].push_back(r);
-    sort_unique(readers[k]);
-    readers_.insert(readers_.end(), readers[k].begin(), readers[k].end());
-    reader_offsets_.push_back(static_cast<Index>(readers_.size()));
-  }
+      if (r != me) entries.push_back({static_cast<Index>(k), r});
+  sort_unique(entries);
+  reader_offsets_.assign(home.size() + 1, 0);
+  readers_.clear();
+  for (const auto& [k, r] : entries) ++reader_offsets_[k + 1], readers_.push_back(r);
+  for (size_t k = 0; k < home.size(); ++k) reader_offsets_[k + 1] += reader_offsets_[k];
 }
 
 Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }

@@ -182,8 +182,6 @@ class ContactPatch {
   void renumber(std::vector<Index> nodes);
   /// Appends known vertex n to `nodes` unless marked, and marks it.
   void add_node(Index n, std::vector<Index>& nodes);
-  /// Clears the marks of `nodes` (from add_node) and sorts them by whole id.
-  void sort_marked(std::vector<Index>& nodes);
   /// Sorts known vertices by whole id.
   void sort_by_whole(std::vector<Index>& nodes) const;
   /// The known id of the vertex `whole`, which becomes known with its owner, body and twin
@@ -218,7 +216,7 @@ class ContactPatch {
     Index twin;           ///< its twin class (twin())
     Index position = -1;  ///< its patch node, -1 if none
     Index ring = -1;      ///< its ring (k: ring_offsets_[k]), -1 before it is fetched
-    bool mark = false;    ///< scratch of reach() and activate(), false between calls
+    bool mark = false;    ///< scratch of reach(), false between calls
   };
   std::vector<KnownVertex> known_;
   std::unordered_map<Index, Index> known_at_;  ///< known id of a whole id
