@@ -6,6 +6,7 @@
 #include <map>
 
 #include "kernels/error.hpp"
+#include "runtime/allgather_list.hpp"
 
 namespace shatter {
 
@@ -106,12 +107,7 @@ std::vector<int> ContactPartition::partition(std::span<const Index> names, std::
   for (size_t k = 0; k < to.size(); ++k) ++mine[{to[k], homes[k]}];
   std::vector<long> words;
   for (const auto& [key, count] : mine) words.insert(words.end(), {key.first, key.second, count});
-  int count = static_cast<int>(words.size());
-  std::vector<int> counts(size_), offsets(size_ + 1, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  for (int r = 0; r < size_; ++r) offsets[r + 1] = offsets[r] + counts[r];
-  std::vector<long> all(offsets[size_]);
-  MPI_Allgatherv(words.data(), count, MPI_LONG, all.data(), counts.data(), offsets.data(), MPI_LONG, comm_);
+  const std::vector<long> all = allgather_list(std::span<const long>(words), MPI_LONG, comm_);
   std::vector<std::array<long, 3>> overlap(all.size() / 3);
   for (size_t k = 0; k < overlap.size(); ++k) overlap[k] = {all[3 * k], all[3 * k + 1], all[3 * k + 2]};
   const std::vector<int> rank_of = align_parts(size_, std::move(overlap));

@@ -8,6 +8,7 @@
 #include "kernels/error.hpp"
 #include "mesh/partition.hpp"
 #include "mesh/reorder.hpp"
+#include "runtime/allgather_list.hpp"
 #include "runtime/alltoall_lists.hpp"
 #include "runtime/comm_place.hpp"
 #include "runtime/global_sum.hpp"
@@ -303,30 +304,15 @@ std::string Decomposition::broadcast(std::string text, int root) const {
   return text;
 }
 
-namespace {
-
-template <class T>
-std::vector<T> allgather_of(std::span<const T> mine, MPI_Datatype type, MPI_Comm comm, int ranks) {
-  std::vector<int> counts(ranks), displs(ranks, 0);
-  const int n = static_cast<int>(mine.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  for (int r = 1; r < ranks; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<T> all(displs[ranks - 1] + counts[ranks - 1]);
-  MPI_Allgatherv(mine.data(), n, type, all.data(), counts.data(), displs.data(), type, comm);
-  return all;
-}
-
-}  // namespace
-
 std::vector<Index> Decomposition::allgather(std::span<const Index> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   static_assert(sizeof(Index) == sizeof(int));
-  return allgather_of(mine, MPI_INT, comm_, size_);
+  return allgather_list(mine, MPI_INT, comm_);
 }
 
 std::vector<double> Decomposition::allgather(std::span<const double> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
-  return allgather_of(mine, MPI_DOUBLE, comm_, size_);
+  return allgather_list(mine, MPI_DOUBLE, comm_);
 }
 
 std::vector<GlobalId> Decomposition::share_with_neighbours(std::span<const GlobalId> mine) const {
@@ -358,7 +344,7 @@ std::vector<std::vector<T>> Decomposition::alltoall_of(const std::vector<std::ve
 std::vector<GlobalId> Decomposition::allgather(std::span<const GlobalId> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   static_assert(sizeof(GlobalId) == sizeof(std::int64_t));
-  return allgather_of(mine, MPI_INT64_T, comm_, size_);
+  return allgather_list(mine, MPI_INT64_T, comm_);
 }
 
 double Decomposition::min(double value) const {
