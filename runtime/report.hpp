@@ -12,7 +12,9 @@
 namespace shatter {
 
 /// A CSV file with a header row; numbers written with 17 significant digits
-/// so that a row read back is the same double.
+/// (as printf's %.17g) so that a row read back is the same double. Rows reach
+/// the file at flush(), which a writer calls once per output step (history.csv
+/// and bodies.csv: one flush for the step's rows, not one system call per row).
 class CsvWriter {
  public:
   /// append: keep the file's rows (a restart; its header must be `columns`)
@@ -24,6 +26,8 @@ class CsvWriter {
   CsvWriter& operator<<(int v) { return *this << static_cast<long>(v); }
   CsvWriter& operator<<(const std::string& s);
   void end_row();
+  /// The rows so far into the file (a killed run keeps them); exits on a write error.
+  void flush();
 
  private:
   void sep();

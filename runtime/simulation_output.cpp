@@ -40,7 +40,8 @@ void Simulation::write_outputs(bool fields) {
     r[0] += m;
     for (int c = 0; c < 3; ++c) r[1 + c] += m * x_[i][c], r[4 + c] += m * v_[i][c];
   }
-  timed(comm_seconds_, [&] { dec_->sum(sums); });
+  // Only the root writes them.
+  if (dec_->distributed()) timed(comm_seconds_, [&] { reduce_to_root(sums, dec_->comm()); });
   for (int b = 0; b < nb && root; ++b) {
     const ExactSum* r = sums.data() + static_cast<size_t>(b) * 7;
     const double mass = r[0].value();
@@ -51,6 +52,7 @@ void Simulation::write_outputs(bool fields) {
     bodies_->end_row();
   }
 
+  if (root) history_->flush(), bodies_->flush();
   if (fields && fields_) write_fields(frags ? frags->elem_fragment : std::span<const Index>{});
 }
 
@@ -225,6 +227,7 @@ CrackArea Simulation::write_fragments() {
         << s.velocity.x() << s.velocity.y() << s.velocity.z() << static_cast<long>(s.elements);
     out.end_row();
   }
+  out.flush();
   return {areas[0], areas[1], areas[2]};
 }
 
