@@ -157,6 +157,30 @@ Links link_found(std::span<const FoundPair> found, std::span<const DcrKey> keys,
 
 }  // namespace
 
+std::vector<double> pair_gaps(std::span<const ContactPair> pairs, std::span<const Vec3> x, const DcrSurface& surface) {
+  std::vector<double> gaps(pairs.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const ContactPair& p = pairs[k];
+      const int first = p.kind == ContactPair::VertexFace ? 1 : 2;  // side A: nodes [0, first)
+      Box side[2];
+      double scale = 0;
+      for (int s = 0; s < 2; ++s) {
+        side[s] = {x[p.nodes[s == 0 ? 0 : first]], x[p.nodes[s == 0 ? 0 : first]]};
+        for (int i = s == 0 ? 0 : first; i < (s == 0 ? first : 4); ++i) {
+          side[s].lo = side[s].lo.cwiseMin(x[p.nodes[i]]);
+          side[s].hi = side[s].hi.cwiseMax(x[p.nodes[i]]);
+          scale = std::max(scale, x[p.nodes[i]].cwiseAbs().maxCoeff());
+        }
+      }
+      const double sides = (side[0].hi - side[0].lo).maxCoeff() + (side[1].hi - side[1].lo).maxCoeff();
+      const Vec3 apart = (side[0].lo - side[1].hi).cwiseMax(side[1].lo - side[0].hi);
+      gaps[k] = apart.maxCoeff() - kBoxInflation * sides - pair_thickness(p, surface).reach - 1e-9 * (scale + sides);
+    }
+  });
+  return gaps;
+}
+
 PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface) {
   if (surface.reach.empty()) return {};
   const auto& n = pair.nodes;
@@ -191,6 +215,9 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
   SHATTER_REQUIRE(held_masks.empty() || held_masks.size() == n_nodes,
                   "resolve_contacts: " << held_masks.size() << " held masks for " << n_nodes << " nodes");
   SHATTER_REQUIRE(options.max_sweeps >= 1, "resolve_contacts: max_sweeps = " << options.max_sweeps);
+  SHATTER_REQUIRE(scratch.gaps.empty() || (scratch.gaps.size() == mine.size() && scratch.drift.size() >= n_nodes),
+                  "resolve_contacts: " << scratch.gaps.size() << " gaps for " << mine.size() << " pairs, "
+                                       << scratch.drift.size() << " drifts for " << n_nodes << " nodes");
   for (size_t i = 0; i < mine.size(); ++i)
     for (const Index n : mine[i].nodes)
       SHATTER_REQUIRE(n >= 0 && static_cast<size_t>(n) < n_nodes, "resolve_contacts: node " << n << " of pair " << i
@@ -222,9 +249,20 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
     const size_t n_check = first_round ? mine.size() : kept.size();
     auto checked = [&](size_t k) { return first_round ? static_cast<Index>(k) : kept[k]; };
     std::vector<std::uint8_t> hit(n_check, 0);
+    const bool screen = first_round && !scratch.gaps.empty();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n_check, 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t k = r.begin(); k != r.end(); ++k) {
         const ContactPair& p = mine[checked(k)];
+        if (screen) {
+          const std::span<const double> d = scratch.drift;
+          const bool vf = p.kind == ContactPair::VertexFace;
+          const double a = vf ? d[p.nodes[0]] : std::max(d[p.nodes[0]], d[p.nodes[1]]);
+          const double b = vf ? std::max({d[p.nodes[1]], d[p.nodes[2]], d[p.nodes[3]]}) : std::max(d[p.nodes[2]], d[p.nodes[3]]);
+          if (scratch.gaps[k] > kGapDrift * (a + b)) {
+            hit[k] = 3;  // its swept boxes are apart (DcrScratch::gaps)
+            continue;
+          }
+        }
         if (!first_round &&
             std::none_of(p.nodes.begin(), p.nodes.end(), [&](Index n) { return scratch.moved[n] == previous; }))
           continue;

@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "contact/candidates.hpp"
 #include "contact/dcr_order.hpp"
 #include "contact/pairs.hpp"
 #include "contact/surface.hpp"
@@ -119,7 +120,21 @@ struct DcrScratch {
   long stamp = 0;           ///< rounds started so far, over all calls
   std::vector<Index> overlapping;  ///< out: the pairs of mine (indices) whose swept boxes overlap (last call)
   TriangleNormals normals;         ///< the triangle normals at x_old (DcrSurface::triangles of them)
+  /// The first round's screen without the pairs' points (the caller's, kept between calls):
+  /// per pair of mine (empty: no screen), its box gap at the last search (pair_gaps); per
+  /// node, how far (max norm) its x_old and x_new are from its position then. A pair whose
+  /// gap exceeds kGapDrift x (the largest drift of a node of its first primitive + that of
+  /// its second's) cannot pass pair_boxes_overlap, so its points are not read.
+  std::vector<double> gaps;
+  std::vector<double> drift;
 };
+
+/// The factor on the drifts d_A + d_B of a pair's two primitives under which its gap
+/// (pair_gaps) keeps their swept boxes apart: each one's swept box stays within its d of its
+/// box at the search and grows by at most kBoxInflation x (its side there + 2 d)
+/// (candidates.hpp), so (d_A + d_B) (1 + 2 kBoxInflation); and a relative slack of 1e-9
+/// for the rounding of the boxes' arithmetic.
+inline constexpr double kGapDrift = (1.0 + 2.0 * kBoxInflation) * (1.0 + 1e-9);
 
 /// The surface whose outward normals at x_old orient the pairs (kernels/dcr.hpp
 /// dcr_orientation, surface_normal); without one (null) no pair has normals.
@@ -136,6 +151,14 @@ struct DcrSurface {
 /// The thickness of a pair (kernels/dcr.hpp PairThickness) from surface.reach: h = r of the
 /// vertex + r of the face / r of edge a + r of edge b (a primitive's nodes are of one body).
 PairThickness pair_thickness(const ContactPair& pair, const DcrSurface& surface);
+
+/// Per pair, a lower bound on the gap between the boxes of its two primitives at positions
+/// x: the largest separation along an axis of the boxes of their nodes (<= 0 when they
+/// overlap), less kBoxInflation x the boxes' largest sides, the pair's thickness h
+/// (pair_thickness) and a rounding slack of 1e-9 x (the largest coordinate's magnitude + the
+/// sides). While every node stays within D of x (max norm) at x_old and x_new, a pair with
+/// gap > kGapDrift D fails pair_boxes_overlap (tests/contact/test_dcr_screen.cpp).
+std::vector<double> pair_gaps(std::span<const ContactPair> pairs, std::span<const Vec3> x, const DcrSurface& surface);
 
 /// The outward normals of a pair (surface_normal, from the triangle normals tn of the
 /// configuration wanted): a vertex-face pair's vertex normal (and 0), an edge-edge pair's

@@ -1,8 +1,12 @@
 #include "runtime/contact_stage.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <chrono>
 #include <numeric>
 
@@ -118,6 +122,7 @@ void ContactStage::set_surface(ContactSurface surface, const Mesh& mesh) {
             (model_.is_part() ? model_.part.surface_edge : median_edge_length(surface_, mesh.reference));
   have_candidates_ = false;
   pairs_.clear();
+  scratch_.gaps.clear();
   node_body_.clear();
   if (!dec_) {
     if (by_body()) node_body_ = mesh.node_body;
@@ -198,6 +203,20 @@ bool ContactStage::candidates_valid(std::span<const Vec3> x_old, std::span<const
       },
       [](bool a, bool b) { return a && b; });
   return dec_ ? dec_->max(valid ? 0 : 1) == 0 : valid;
+}
+
+void ContactStage::drifts(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> x_gap,
+                          std::span<const Index> nodes) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const size_t count = nodes.empty() ? x_new.size() : nodes.size();
+  scratch_.drift.resize(x_new.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const Index n = nodes.empty() ? static_cast<Index>(k) : nodes[k];
+      const double d = std::max((x_new[n] - x_gap[n]).cwiseAbs().maxCoeff(), (x_old[n] - x_gap[n]).cwiseAbs().maxCoeff());
+      scratch_.drift[n] = std::isnan(d) ? inf : d;  // a NaN passes no screen
+    }
+  });
 }
 
 void ContactStage::search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) {
@@ -509,6 +528,11 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     DcrRigidBodies patch_rigid;
     if (rigid) rigid_body = patch_rigid_bodies(*rigid), patch_rigid = {rigid_body, rigid->bodies};
     const DcrSurface surface{&patch_->normals(), &patch_->normals_around(), {}, patch_->node_reach()};
+    if (!valid) {
+      scratch_.gaps = pair_gaps(pairs_, patch_->x_new(), surface);
+      gap_x_.assign(patch_->x_new().begin(), patch_->x_new().end());
+    }
+    drifts(patch_->x_old(), patch_->x_new(), gap_x_, {});
     r = resolve_contacts(pairs_, patch_->x_new(), patch_->x_old(), patch_->v(), patch_->inv_mass(), dt, options_,
                          surface, scratch_, ranks_.get(), patch_->held(), rigid ? &patch_rigid : nullptr);
     patch_->store(x_old, x_new, v);
@@ -521,6 +545,8 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
     if (r.capped) r.unresolved = first_unresolved(r.unresolved);
   } else {
     const DcrSurface surface{&surface_, &vertex_triangles_, {}, reach_};
+    if (!valid) scratch_.gaps = pair_gaps(pairs_, x_new, surface);
+    drifts(x_old, x_new, x_search_, surface_.vertices);
     r = resolve_contacts(pairs_, x_new, x_old, v, inv_mass, dt, options_, surface, scratch_, nullptr, held, rigid);
     if (r.unresolved) {
       UnresolvedPair& u = unresolved_.emplace();

@@ -168,6 +168,10 @@ class ContactStage {
   /// Whether excluded() reads the pairs' bodies.
   bool by_body() const { return !body_pairs_.empty() || !self_ || any_free_rigid_ || !reach_.empty(); }
   void search(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
+  /// DCR's screen (DcrScratch::drift): per node of `nodes` (empty: every one), how far (max
+  /// norm) x_old and x_new are from x_gap, where the last search measured the pairs' gaps.
+  void drifts(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> x_gap,
+              std::span<const Index> nodes);
   /// On several ranks: the patch's search, with a new RCB partition when needed (the rule
   /// in contact_stage.cpp).
   void search_patch(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v);
@@ -225,6 +229,7 @@ class ContactStage {
   std::vector<char> shell_body_;                ///< per body: a shell (never in contact with itself)
   std::vector<double> reach_;                   ///< per node: a shell node's half-thickness, m, else 0; empty: no shells (grows the search boxes: inflated_boxes)
   std::vector<Vec3> x_search_;  ///< x_new of the last search, per mesh node
+  std::vector<Vec3> gap_x_;     ///< on several ranks, the patch's x_new at the last search (pair_gaps)
   DcrScratch scratch_;
   ContactProfile profile_;
   std::optional<UnresolvedPair> unresolved_;
