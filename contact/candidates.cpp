@@ -12,9 +12,30 @@
 namespace shatter {
 namespace {
 
+/// The inflated box of K points moving from x_old(k) to x_new(k), k < K.
+template <size_t K, class Old, class New>
+Box swept_box(Old x_old, New x_new) {
+  Box b{x_old(0), x_old(0)};
+  for (size_t k = 0; k < K; ++k) {
+    b.lo = b.lo.cwiseMin(x_old(k)).cwiseMin(x_new(k));
+    b.hi = b.hi.cwiseMax(x_old(k)).cwiseMax(x_new(k));
+  }
+  const double grow = kBoxInflation * (b.hi - b.lo).maxCoeff();
+  b.lo.array() -= grow;
+  b.hi.array() += grow;
+  return b;
+}
+
 template <size_t K>
 Box swept_box(const std::array<Index, K>& nodes, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {
-  return shatter::swept_box<K>([&](size_t k) { return x_old[nodes[k]]; }, [&](size_t k) { return x_new[nodes[k]]; });
+  return swept_box<K>([&](size_t k) { return x_old[nodes[k]]; }, [&](size_t k) { return x_new[nodes[k]]; });
+}
+
+/// The swept box of the K columns of a pair's points from column `first` on.
+template <size_t K>
+Box swept_box(const PairPoints& X_old, const PairPoints& X_new, int first) {
+  return swept_box<K>([&](size_t k) { return Vec3(X_old.col(first + k)); },
+                      [&](size_t k) { return Vec3(X_new.col(first + k)); });
 }
 
 template <size_t K, class Nodes>
@@ -62,6 +83,17 @@ std::optional<ContactPair> edge_edge_pair(const ContactSurface& surface, Index e
   const auto& b = surface.edges[f];
   if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return std::nullopt;
   return ContactPair{ContactPair::EdgeEdge, {a[0], a[1], b[0], b[1]}};
+}
+
+bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new, double reach) {
+  const bool vf = kind == ContactPair::VertexFace;
+  Box a = vf ? swept_box<1>(X_old, X_new, 0) : swept_box<2>(X_old, X_new, 0);
+  const Box b = vf ? swept_box<3>(X_old, X_new, 1) : swept_box<2>(X_old, X_new, 2);
+  if (reach > 0.0) {
+    a.lo.array() -= reach;
+    a.hi.array() += reach;
+  }
+  return boxes_overlap(a, b);
 }
 
 bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, std::span<const Vec3> x_new) {

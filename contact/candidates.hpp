@@ -36,28 +36,6 @@ struct SweptBoxes {
 SweptBoxes swept_boxes(const ContactSurface& surface, std::span<const Vec3> x_old,
                        std::span<const Vec3> x_new);
 
-/// The inflated box of K points moving from x_old(k) to x_new(k), k < K (callables giving
-/// Vec3): the box of swept_boxes and of pair_boxes_overlap, which must agree to the bit.
-template <size_t K, class Old, class New>
-Box swept_box(Old x_old, New x_new) {
-  Box b{x_old(0), x_old(0)};
-  for (size_t k = 0; k < K; ++k) {
-    b.lo = b.lo.cwiseMin(x_old(k)).cwiseMin(x_new(k));
-    b.hi = b.hi.cwiseMax(x_old(k)).cwiseMax(x_new(k));
-  }
-  const double grow = kBoxInflation * (b.hi - b.lo).maxCoeff();
-  b.lo.array() -= grow;
-  b.hi.array() += grow;
-  return b;
-}
-
-/// The swept box of the K columns of a pair's points from column `first` on.
-template <size_t K>
-Box swept_box(const PairPoints& X_old, const PairPoints& X_new, int first) {
-  return swept_box<K>([&](size_t k) { return Vec3(X_old.col(first + k)); },
-                      [&](size_t k) { return Vec3(X_new.col(first + k)); });
-}
-
 /// The vertex-face pair of surface vertex v and triangle t, nodes
 /// {vertex, tri0, tri1, tri2}; none when the vertex is a node of the triangle.
 std::optional<ContactPair> vertex_face_pair(const ContactSurface& surface, Index v, Index t);
@@ -73,18 +51,8 @@ bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, st
 /// The same on the pair's points already gathered (columns in ContactPair::nodes order), the
 /// first primitive's box grown by `reach` (m) on every side: a thick pair's h (PairThickness),
 /// whose primitives touch at that distance.
-/// Inline: DCR's first round screens every candidate with it, each step.
-inline bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new,
-                               double reach = 0.0) {
-  const bool vf = kind == ContactPair::VertexFace;
-  Box a = vf ? swept_box<1>(X_old, X_new, 0) : swept_box<2>(X_old, X_new, 0);
-  const Box b = vf ? swept_box<3>(X_old, X_new, 1) : swept_box<2>(X_old, X_new, 2);
-  if (reach > 0.0) {
-    a.lo.array() -= reach;
-    a.hi.array() += reach;
-  }
-  return boxes_overlap(a, b);
-}
+bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new,
+                        double reach = 0.0);
 
 /// Sort by ContactPair's operator< and drop duplicates (oneTBB parallel sort
 /// on a total order: the result does not depend on the thread count).

@@ -162,12 +162,13 @@ std::vector<double> pair_gaps(std::span<const ContactPair> pairs, std::span<cons
   tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
       const ContactPair& p = pairs[k];
-      const int first = p.kind == ContactPair::VertexFace ? 1 : 2;  // side A: nodes [0, first)
+      const int first = p.kind == ContactPair::VertexFace ? 1 : 2;
+      const int begin[2] = {0, first}, end[2] = {first, 4};  // the nodes of side A and of side B
       Box side[2];
       double scale = 0;
       for (int s = 0; s < 2; ++s) {
-        side[s] = {x[p.nodes[s == 0 ? 0 : first]], x[p.nodes[s == 0 ? 0 : first]]};
-        for (int i = s == 0 ? 0 : first; i < (s == 0 ? first : 4); ++i) {
+        side[s] = {x[p.nodes[begin[s]]], x[p.nodes[begin[s]]]};
+        for (int i = begin[s]; i < end[s]; ++i) {
           side[s].lo = side[s].lo.cwiseMin(x[p.nodes[i]]);
           side[s].hi = side[s].hi.cwiseMax(x[p.nodes[i]]);
           scale = std::max(scale, x[p.nodes[i]].cwiseAbs().maxCoeff());

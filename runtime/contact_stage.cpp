@@ -5,9 +5,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
-#include <chrono>
 #include <numeric>
 
 #include "contact/candidates.hpp"
