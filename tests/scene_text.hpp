@@ -5,15 +5,26 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "runtime/scene.hpp"
 
 namespace shatter::test {
 
-/// Write `yaml` to a file named `name`.yaml in a test folder; return its path.
-inline std::string write_scene(const std::string& name, const std::string& yaml) {
-  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_scenes";
+/// This process's folder of scenes (and the files they name). ctest runs tests
+/// side by side, the same test program too (a test alone and under mpiexec):
+/// a folder shared by processes let one read a scene while another rewrote it.
+/// (The ranks of one run can share rank 0's: pass its process id.)
+inline std::filesystem::path scenes_dir(pid_t process = getpid()) {
+  const auto dir =
+      std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_scenes" / std::to_string(process);
   std::filesystem::create_directories(dir);
-  const auto path = dir / (name + ".yaml");
+  return dir;
+}
+
+/// Write `yaml` to a file named `name`.yaml in this process's scenes folder; return its path.
+inline std::string write_scene(const std::string& name, const std::string& yaml) {
+  const auto path = scenes_dir() / (name + ".yaml");
   std::ofstream(path) << yaml;
   return path.string();
 }
@@ -55,7 +66,6 @@ inline std::string steel_box_scene(const std::string& name, const std::string& e
                           "1.0e-6");
 }
 
-/// A double as scene text, every bit kept (%.17g).
 /// A steel sphere (radius 10 mm) and a 20 mm steel box beside it, with contact:
 /// the contact stage's tests move them into each other.
 inline std::string sphere_and_box_contact_scene(const std::string& name) {
@@ -70,6 +80,7 @@ inline std::string sphere_and_box_contact_scene(const std::string& name) {
          "contact: {}\n";
 }
 
+/// A double as scene text, every bit kept (%.17g).
 inline std::string num(double a) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", a);

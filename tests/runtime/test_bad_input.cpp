@@ -130,9 +130,7 @@ TEST(BadInput, EachErrorClassExitsTwoNamingTheKey) {
 }
 
 TEST(BadInput, InvertedElementInAMeshFileIsNamed) {
-  const auto dir = std::filesystem::path(SHATTER_BINARY_DIR "/test_scratch") / "shatter_test_scenes";
-  std::filesystem::create_directories(dir);
-  std::ofstream(dir / "inverted.msh")
+  std::ofstream(shatter::test::scenes_dir() / "inverted.msh")
       << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 0 0 -1\n"
          "$EndNodes\n$Elements\n2\n1 4 2 1 1 1 2 3 4\n42 4 2 1 1 2 3 1 5\n$EndElements\n";
   const std::string path = shatter::test::write_scene(

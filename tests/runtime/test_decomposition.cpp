@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include "mpi_environment.hpp"
@@ -39,16 +40,19 @@ int world_size() {
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   return ranks;
 }
-/// The scene `yaml`, written by each rank to a file of its own (one file
-/// written by all would race).
-Scene rank_scene(const std::string& name, const std::string& yaml) {
-  return test::scene_from_text(name + "_rank" + std::to_string(world_rank()), yaml);
+/// A file of rank 0's scenes folder, the same path on every rank and a path
+/// of this run only.
+std::filesystem::path run_file(const std::string& name) {
+  int process = getpid();
+  MPI_Bcast(&process, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return test::scenes_dir(process) / name;
 }
 
 const Model& box() {
-  static const Model m = build_model(rank_scene(
-      "decomposition_box", test::steel_body_scene("decomposition_box",
-                                                  "shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1")));
+  static const Model m = build_model(test::scene_from_text(
+      "decomposition_box",
+      test::steel_body_scene("decomposition_box",
+                             "shape: box, size: [0.02, 0.016, 0.012], element_size: 0.0015, order: 1")));
   return m;
 }
 
@@ -258,7 +262,7 @@ TEST(Decomposition, BuildModelOnSeveralRanksCutsTheWholeIntoParts) {
   // elements and ghost layer), which holds the whole model's values and, in
   // the element loop, gives the whole model's forces bit for bit.
   const int ranks = world_size();
-  const Scene scene = rank_scene(
+  const Scene scene = test::scene_from_text(
       "build_model_world",
       test::steel_body_scene("world", "shape: sphere, radius: 0.01, element_size: 0.0015, order: 2",
                              "    initial_velocity: [1, 0, 0]\n"
@@ -320,7 +324,7 @@ TEST(Decomposition, ContactPartsHoldTheSurfaceButNotItsNodesRows) {
   // bodies' surface nodes only; of the whole surface it brings the rigid bodies' surface
   // nodes with their volume owners and the median edge, not the triangles nor the other
   // vertices.
-  const Scene scene = rank_scene(
+  const Scene scene = test::scene_from_text(
       "contact_parts",
       "name: contact_parts\ntime: {end: 1.0e-5}\n"
       "materials:\n  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3}\n"
@@ -370,7 +374,7 @@ TEST(Decomposition, FracturePartsSplitNodesAsTheWholeModel) {
   // and takes the whole model's index; the ranks touching it come from the
   // part's stars. Two rounds of insertion, the second splitting copies.
   const int ranks = world_size();
-  const Scene scene = rank_scene(
+  const Scene scene = test::scene_from_text(
       "fracture_parts",
       "name: fracture_parts\ntime: {end: 1.0}\nmaterials:\n"
       "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3,\n"
@@ -434,7 +438,7 @@ TEST(Decomposition, FractureRestartOnPartsReadsItsOwnRows) {
   // the rows of its elements' nodes and of its facets' cohesive elements, and
   // continues the run bit for bit.
   const int ranks = world_size();
-  const Scene scene = rank_scene(
+  const Scene scene = test::scene_from_text(
       "fracture_restart_parts",
       "name: fracture_restart_parts\ntime: {end: 1.0}\nmaterials:\n"
       "  alu: {model: neo_hookean, density: 2750, youngs_modulus: 275.0e9, poisson_ratio: 0.3,\n"
@@ -446,7 +450,7 @@ TEST(Decomposition, FractureRestartOnPartsReadsItsOwnRows) {
   while (one.ledger().cohesive_elements == 0 && one.steps() < 400) one.step();
   for (int s = 0; s < 20; ++s) one.step();
   ASSERT_GT(one.ledger().cohesive_elements, 0) << "the box did not crack";
-  const std::filesystem::path file = std::filesystem::temp_directory_path() / "shatter_fracture_restart_parts.h5";
+  const std::filesystem::path file = run_file("fracture_restart_parts.h5");
   if (world_rank() == 0) {
     SimulationState state;
     one.save_state(state);
@@ -489,7 +493,7 @@ TEST(Decomposition, UpdateAfterInsertionEqualsRebuild) {
   // update_nodes, around the split nodes only, leaves the lists and the halo
   // plan that rebuild_nodes makes over the whole part; three rounds of
   // insertion on the parts of two ghost layers, the later ones splitting copies.
-  const Scene scene = rank_scene(
+  const Scene scene = test::scene_from_text(
       "fracture_update",
       "name: fracture_update\ntime: {end: 1.0}\nmaterials:\n"
       "  steel: {model: neo_hookean, density: 7850, youngs_modulus: 210.0e9, poisson_ratio: 0.3,\n"
