@@ -4,13 +4,18 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <vector>
 
 namespace shatter {
 namespace {
 
-char g_reserve[4096] = "";  // a fixed buffer: read by a signal handler
+// A fixed buffer, read by a signal handler once g_named says it holds the
+// whole path: the path is published before the file is created, so a stop
+// during the write (1 MiB and an fsync: slow on a busy disk) removes it too.
+char g_reserve[4096] = "";
+volatile std::sig_atomic_t g_named = 0;
 
 /// Writes all of `bytes`; returns 0 or the errno of the failure (ENOSPC when
 /// the file system took fewer bytes without saying why).
@@ -32,22 +37,22 @@ std::string reserve_disk_space(const std::filesystem::path& dir) {
   release_disk_space();
   const std::filesystem::path file = dir / ".shatter_reserve";
   if (file.native().size() >= sizeof g_reserve) return "path too long";
+  std::strcpy(g_reserve, file.c_str());
+  g_named = 1;
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) return std::strerror(errno);
-  const int err = write_all(fd, std::vector<char>(kDiskReserveBytes, 0));
-  ::close(fd);
+  const int err = fd < 0 ? errno : write_all(fd, std::vector<char>(kDiskReserveBytes, 0));
+  if (fd >= 0) ::close(fd);
   if (err != 0) {
-    ::unlink(file.c_str());
+    release_disk_space();
     return std::strerror(err);
   }
-  std::strcpy(g_reserve, file.c_str());
   return "";
 }
 
 void release_disk_space() {
-  if (g_reserve[0] == '\0') return;
-  ::unlink(g_reserve);
-  g_reserve[0] = '\0';
+  if (!g_named) return;
+  ::unlink(g_reserve);  // before the flag falls: a stop in between unlinks it again, harmlessly
+  g_named = 0;
 }
 
 std::string lacking_space(const std::filesystem::path& dir, std::uintmax_t bytes) {
@@ -60,14 +65,14 @@ std::string lacking_space(const std::filesystem::path& dir, std::uintmax_t bytes
 }
 
 bool output_folder_is_full() {
-  if (g_reserve[0] == '\0') return false;
+  if (!g_named) return false;
   std::error_code ec;
   const std::filesystem::space_info s = std::filesystem::space(std::filesystem::path(g_reserve).parent_path(), ec);
   return !ec && s.available < 64 * 1024;
 }
 
 const char* disk_reserve_path() {
-  return g_reserve;
+  return g_named ? g_reserve : "";
 }
 
 }  // namespace shatter
