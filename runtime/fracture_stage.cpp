@@ -1,6 +1,7 @@
 #include "runtime/fracture_stage.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -26,6 +27,7 @@ GlobalId largest_node_gid(const Mesh& mesh, const Decomposition& dec) {
 
 FractureStage::FractureStage(Model& model, const Decomposition& dec)
     : model_(model), dec_(dec), topology_(build_topology(model.mesh, largest_node_gid(model.mesh, dec))) {
+  stamp_facets();
   const Mesh& mesh = model.mesh;
   const size_t nm = model.scene.materials.size();
   // The whole model's smallest altitude per material, from the owned elements.
@@ -170,7 +172,10 @@ Insertion FractureStage::insert(std::span<const GlobalId> gids, const KeyPositio
   const std::vector<Index> held = facets(gids);
   Insertion ins;
   ins.first_cohesive = cohesive_.size();
-  if (!held.empty()) ins = insert_cohesive_elements(model_.mesh, topology_, cohesive_, held);
+  if (!held.empty()) {
+    ins = insert_cohesive_elements(model_.mesh, topology_, cohesive_, held);
+    stamp_facets();
+  }
   // The whole model inserts its critical facets in the order of their ids.
   for (Index c = ins.first_cohesive; c < cohesive_.size(); ++c) {
     const auto at = std::lower_bound(gids.begin(), gids.end(), topology_.facet_gid[cohesive_.facet[c]]) - gids.begin();
@@ -239,6 +244,7 @@ std::vector<std::array<Index, 2>> FractureStage::bonded_twins() const {
 void FractureStage::release(std::span<const GlobalId> gids, Index freed) {
   const std::vector<Index> held = facets(gids);
   for (Index f : held) topology_.facet_state[f] = FacetState::free;
+  if (!held.empty()) stamp_facets();
   released_ += static_cast<Index>(held.size());  // freed facets exert no force: the eigenvalue bound's key changes
   // (The fragments change on every rank, whichever facets it holds.)
   if (freed > 0) ++facet_revision_;
@@ -261,6 +267,11 @@ const Fragments& FractureStage::fragment_labels() const {
   return labels_;
 }
 
+void FractureStage::stamp_facets() {
+  static std::atomic<std::uint64_t> last{0};
+  facet_stamp_ = ++last;
+}
+
 void FractureStage::save(FractureState& s) const {
   const Mesh& mesh = model_.mesh;
   // (On a part the outer ghost layer may split without a new revision: the sizes tell.)
@@ -269,16 +280,19 @@ void FractureStage::save(FractureState& s) const {
     copy_node_arrays(s, model_);
     s.conn = mesh.conn;
   }
-  s.facet_gid.clear();
-  s.facet_state.clear();
-  for (Index f : by_gid_)
-    if (topology_.facet_state[f] != FacetState::intact) {
-      s.facet_gid.push_back(topology_.facet_gid[f]);
-      s.facet_state.push_back(topology_.facet_state[f]);
-    }
+  if (s.facet_stamp != facet_stamp_) {
+    s.facet_stamp = facet_stamp_;
+    s.facet_gid.clear();
+    s.facet_state.clear();
+    for (Index f : by_gid_)
+      if (topology_.facet_state[f] != FacetState::intact) {
+        s.facet_gid.push_back(topology_.facet_gid[f]);
+        s.facet_state.push_back(topology_.facet_state[f]);
+      }
+    s.cohesive_facet_gid = gids(cohesive_.facet);
+  }
   s.cohesive = cohesive_;
   s.cohesive.facet.clear();
-  s.cohesive_facet_gid = gids(cohesive_.facet);
   s.whole_nodes = model_.whole_nodes();
   s.whole_cohesive = whole_cohesive_;
   s.cohesive_whole = cohesive_whole_;
@@ -331,6 +345,7 @@ void FractureStage::restore(const FractureState& whole) {
   for (Index f : by_gid_) topology_.facet_state[f] = FacetState::intact;
   for (size_t i = 0; i < open.size(); ++i) topology_.facet_state[open[i]] = s.facet_state[i];
   ++facet_revision_;
+  stamp_facets();
   cohesive_ = s.cohesive;
   cohesive_.facet = cohesive_facets;
   facet_cohesive_.assign(topology_.num_facets(), -1);

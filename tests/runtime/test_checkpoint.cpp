@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -498,6 +499,33 @@ TEST(Checkpoint, RestoredRunWithReleasesAfterTheCheckpointIsBitwiseTheUninterrup
       << "no node split before the checkpoint: move it later";
   EXPECT_GT(at_end.fragments, at_checkpoint.fragments)
       << "no piece separated after the checkpoint: run longer";
+}
+
+// The run saves its state before every step into one SimulationState (the
+// last good state of a failure), and lists the broken facets again only when
+// a facet changed state since (FractureStage's facet stamp): the reused state
+// holds, at every step, the lists a fresh one gets, through insertions and
+// releases.
+TEST(Checkpoint, ReusedStateListsTheBrokenFacetsOfAFreshOne) {
+  const Scene scene = scene_from_text("reused_state", pellet_scene("reused_state", "200"));
+  Model model = build_model(scene);
+  Simulation sim(model, {});
+  SimulationState reused;
+  bool freed = false;
+  for (int s = 0; s < 60; ++s) {
+    sim.save_state(reused);
+    SimulationState fresh;
+    sim.save_state(fresh);
+    ASSERT_TRUE(reused.fracture && fresh.fracture);
+    EXPECT_EQ(reused.fracture->facet_gid, fresh.fracture->facet_gid) << "step " << s;
+    EXPECT_EQ(reused.fracture->facet_state, fresh.fracture->facet_state) << "step " << s;
+    EXPECT_EQ(reused.fracture->cohesive_facet_gid, fresh.fracture->cohesive_facet_gid) << "step " << s;
+    freed = freed || std::count(fresh.fracture->facet_state.begin(), fresh.fracture->facet_state.end(),
+                                FacetState::free) > 0;
+    sim.step();
+  }
+  EXPECT_GT(sim.ledger().cohesive_elements, 0) << "no crack: the test saw no insertion";
+  EXPECT_TRUE(freed) << "no facet freed: the test saw no release";
 }
 
 // A write that fails (here: the temporary file cannot be created) throws and
