@@ -41,10 +41,7 @@ ContactPairs unflatten(const std::vector<Index>& in) {
 }
 
 TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const Model m = build_model(
-      test::scene_from_text("patch_rank" + std::to_string(rank), test::sphere_and_box_contact_scene("patch")));
+  const Model m = build_model(test::scene_from_text("patch", test::sphere_and_box_contact_scene("patch")));
   const Decomposition dec(m, MPI_COMM_WORLD);
   ContactStage stage(m, ContactSpec{}, &dec);
   const Index n = m.mesh.num_nodes();

@@ -4,6 +4,7 @@
 // sums over the owned granules give the serial total, and the restricted element loop gives touched nodes the
 // serial forces bit for bit.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>

@@ -35,8 +35,7 @@ void check_order(int order) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  const Scene scene = test::scene_from_text("named_o" + std::to_string(order) + "_rank" + std::to_string(rank),
-                                            scene_text(order));
+  const Scene scene = test::scene_from_text("named_o" + std::to_string(order), scene_text(order));
   const Model part = build_model(scene, MPI_COMM_WORLD), whole = build_model(scene);
   EXPECT_EQ(part.is_part(), ranks > 1);
   const Decomposition dec(part, MPI_COMM_WORLD);
