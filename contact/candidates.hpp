@@ -54,8 +54,9 @@ bool pair_boxes_overlap(const ContactPair& pair, std::span<const Vec3> x_old, st
 bool pair_boxes_overlap(ContactPair::Kind kind, const PairPoints& X_old, const PairPoints& X_new,
                         double reach = 0.0);
 
-/// Sort by ContactPair's operator< and drop duplicates (oneTBB parallel sort
-/// on a total order: the result does not depend on the thread count).
+/// Sort by ContactPair's operator< and drop duplicates (a radix sort of the
+/// pairs packed into 96 bits, or oneTBB's parallel sort where node ids pass
+/// 2^23: the result does not depend on the thread count).
 void canonicalize(ContactPairs& pairs);
 
 /// Candidate pairs of a surface moving from x_old to x_new: every vertex-face

@@ -4,22 +4,31 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_scan.h>
-#include <tbb/parallel_sort.h>
 
-#include <tuple>
+#include <bit>
+
+#include "contact/radix_sort.hpp"
 
 namespace shatter {
 namespace {
 
+/// The float next to f toward -inf (down) or +inf, for finite f or f = +-inf
+/// from a finite double beyond the float range (then FLT_MAX or -FLT_MAX).
+float float_step(float f, bool down) {
+  std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
+  if (f == 0.0f) return std::bit_cast<float>(down ? 0x80000001u : 0x00000001u);  // smallest subnormals
+  bits += (f > 0.0f) == down ? std::uint32_t(-1) : 1u;
+  return std::bit_cast<float>(bits);
+}
+
 /// Nearest float not above (below) x, so float bounds contain the double box.
 float round_down(double x) {
   const auto f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
-                                    : f;
+  return static_cast<double>(f) > x ? float_step(f, true) : f;
 }
 float round_up(double x) {
   const auto f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+  return static_cast<double>(f) < x ? float_step(f, false) : f;
 }
 
 double largest_side(const Box& b) {
@@ -59,12 +68,6 @@ double base_cell_size(std::span<const Box> boxes, const Box& all) {
   // keep cell indices inside 29 bits
   return std::max(h, span * 0x1p-28);
 }
-
-struct Entry {
-  std::uint64_t key;
-  double lo;
-  Index box;
-};
 
 }  // namespace
 
@@ -108,6 +111,17 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
     j1 = b.cell(1, l, boxes[k].hi[v]);
   };
 
+  // Each box's float bounds, rounded outward: {lo_w, hi_w, lo_u, hi_u, lo_v, hi_v}.
+  const int wa = b.axis[2];
+  std::vector<std::array<float, 6>> bounds(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const Box& x = boxes[k];
+      bounds[k] = {round_down(x.lo[wa]), round_up(x.hi[wa]), round_down(x.lo[u]),
+                   round_up(x.hi[u]),    round_down(x.lo[v]), round_up(x.hi[v])};
+    }
+  });
+
   // Entries: one per (box, cell it spans); offsets by a parallel prefix sum.
   std::vector<size_t> first(n + 1, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
@@ -127,23 +141,24 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
         return sum;
       },
       [](size_t a, size_t c) { return a + c; });
-  std::vector<Entry> entries(first[n]);
-  const int wa = b.axis[2];
+  // Sorted by cell, then by the float lo_w (the order the queries bisect), then by box
+  // (the sort is stable): the same array for any thread count. The cell is packed as
+  // (l, i, j) in just the bits the level-0 grid needs (higher levels need fewer).
+  const int wi = static_cast<int>(std::bit_width(b.cell(0, 0, all.hi[u]))),
+            wj = static_cast<int>(std::bit_width(b.cell(1, 0, all.hi[v])));
+  std::vector<RadixRecord> entries(first[n]);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
       std::uint64_t i0, i1, j0, j1;
       cell_range(k, i0, i1, j0, j1);
+      const std::uint32_t lo = float_order_key(bounds[k][0]);
+      const auto l = static_cast<std::uint64_t>(level[k]) << (wi + wj);
       size_t p = first[k];
       for (std::uint64_t i = i0; i <= i1; ++i)
-        for (std::uint64_t j = j0; j <= j1; ++j)
-          entries[p++] = {SparseBucket::key(level[k], i, j), boxes[k].lo[wa],
-                          static_cast<Index>(k)};
+        for (std::uint64_t j = j0; j <= j1; ++j) entries[p++] = {l | (i << wj) | j, lo, static_cast<Index>(k)};
     }
   });
-  // A total order, so the sorted array is the same for any thread count.
-  tbb::parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& c) {
-    return std::tie(a.key, a.lo, a.box) < std::tie(c.key, c.lo, c.box);
-  });
+  radix_sort(entries);
 
   const size_t m = entries.size();
   b.entry_lo.resize(m);
@@ -151,29 +166,36 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   b.entry_box.resize(m);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, m), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k != r.end(); ++k) {
-      const Box& x = boxes[entries[k].box];
-      b.entry_lo[k] = round_down(entries[k].lo);
-      b.entry_bounds[k] = {round_up(x.hi[wa]), round_down(x.lo[u]), round_up(x.hi[u]),
-                           round_down(x.lo[v]), round_up(x.hi[v])};
-      b.entry_box[k] = entries[k].box;
+      const auto& f = bounds[entries[k].id];
+      b.entry_lo[k] = f[0];
+      b.entry_bounds[k] = {f[1], f[2], f[3], f[4], f[5]};
+      b.entry_box[k] = entries[k].id;
     }
   });
+  const std::uint64_t mask_i = (std::uint64_t(1) << wi) - 1, mask_j = (std::uint64_t(1) << wj) - 1;
+  // The cells: where each starts (in order), then their keys and extents.
   b.level_cells.assign(1, 0);
   b.cell_entries.assign(1, 0);
-  for (size_t k = 0; k < m;) {
-    size_t e = k;
-    double extent = 0;
-    for (; e < m && entries[e].key == entries[k].key; ++e) {
-      const Box& x = boxes[entries[e].box];
-      extent = std::max(extent, x.hi[wa] - x.lo[wa]);
+  for (size_t k = 1; k <= m; ++k)
+    if (k == m || entries[k].hi != entries[k - 1].hi) b.cell_entries.push_back(static_cast<Index>(k));
+  const size_t cells = b.cell_entries.size() - 1;
+  b.cell_key.resize(cells);
+  b.cell_max_extent.resize(cells);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t c = r.begin(); c != r.end(); ++c) {
+      double extent = 0;
+      for (auto e = static_cast<size_t>(b.cell_entries[c]); e != static_cast<size_t>(b.cell_entries[c + 1]); ++e) {
+        const Box& x = boxes[entries[e].id];
+        extent = std::max(extent, x.hi[wa] - x.lo[wa]);
+      }
+      b.cell_max_extent[c] = extent;
+      const std::uint64_t packed = entries[b.cell_entries[c]].hi;
+      b.cell_key[c] = SparseBucket::key(static_cast<int>(packed >> (wi + wj)), (packed >> wj) & mask_i, packed & mask_j);
     }
-    const auto level_k = static_cast<int>(entries[k].key >> (2 * SparseBucket::kCellBits));
-    while (static_cast<int>(b.level_cells.size()) <= level_k)
-      b.level_cells.push_back(static_cast<Index>(b.cell_key.size()));
-    b.cell_key.push_back(entries[k].key);
-    b.cell_max_extent.push_back(extent);
-    b.cell_entries.push_back(static_cast<Index>(e));
-    k = e;
+  });
+  for (size_t c = 0; c < cells; ++c) {
+    const auto level_c = static_cast<int>(b.cell_key[c] >> (2 * SparseBucket::kCellBits));
+    while (static_cast<int>(b.level_cells.size()) <= level_c) b.level_cells.push_back(static_cast<Index>(c));
   }
   while (static_cast<int>(b.level_cells.size()) <= max_level + 1)
     b.level_cells.push_back(static_cast<Index>(b.cell_key.size()));

@@ -49,7 +49,7 @@ inline bool boxes_overlap(const Box& a, const Box& b) {
 ///   cell_entries[C+1]               entries of cell c: [cell_entries[c], cell_entries[c+1])
 ///   cell_max_extent[C]              max over the cell's boxes of hi_w - lo_w
 ///   entry_lo[N]                     lo_w of the box as a float rounded down, ascending
-///                                   within a cell (entries sorted by the exact lo_w, then id)
+///                                   within a cell (entries sorted by this float, then id)
 ///   entry_bounds[N]                 {hi_w, lo_u, hi_u, lo_v, hi_v} of the box as floats
 ///                                   rounded outward
 ///   entry_box[N]                    box id

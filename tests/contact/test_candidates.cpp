@@ -247,6 +247,32 @@ TEST(Candidates, OwnedCandidatesAreThePairsOfTheKeptEdgesWithTheirPrimitive) {
   EXPECT_TRUE(owned.primitive == primitive);
 }
 
+TEST(Candidates, CanonicalOrderWithSmallAndLargeNodeIds) {
+  // Node ids below 2^23 take the radix sort, larger ones the comparison sort: the
+  // same canonical list, for 1 and 2 threads, with repeats dropped. Pairs that
+  // tie on their first nodes and differ in the last, of both kinds.
+  for (const Index largest : {Index{5000}, Index{(1 << 23) - 1}, Index{1 << 23}, Index{2000000000}}) {
+    std::mt19937 rng(static_cast<unsigned>(largest));
+    std::uniform_int_distribution<Index> node(0, largest), few(0, 3);
+    ContactPairs pairs;
+    for (int k = 0; k < 40000; ++k) {
+      const auto kind = few(rng) % 2 ? ContactPair::EdgeEdge : ContactPair::VertexFace;
+      pairs.push_back({kind, {few(rng) ? node(rng) : largest, few(rng), node(rng), few(rng) == 0 ? largest : node(rng)}});
+      if (k % 5 == 0) pairs.push_back(pairs.back());
+    }
+    ContactPairs expected = pairs;
+    std::sort(expected.begin(), expected.end());
+    expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+    ASSERT_LT(expected.size(), pairs.size());
+    for (int threads : {1, 2}) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      ContactPairs sorted = pairs;
+      canonicalize(sorted);
+      EXPECT_TRUE(sorted == expected) << "largest node " << largest << ", " << threads << " threads";
+    }
+  }
+}
+
 TEST(Candidates, EmptySurfaceHasNoCandidates) {
   const ContactSurface s;
   const std::vector<Vec3> x;
