@@ -12,25 +12,6 @@
 namespace shatter {
 namespace {
 
-/// The float next to f toward -inf (down) or +inf, for finite f or f = +-inf
-/// from a finite double beyond the float range (then FLT_MAX or -FLT_MAX).
-float float_step(float f, bool down) {
-  std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
-  if (f == 0.0f) return std::bit_cast<float>(down ? 0x80000001u : 0x00000001u);  // smallest subnormals
-  bits += (f > 0.0f) == down ? std::uint32_t(-1) : 1u;
-  return std::bit_cast<float>(bits);
-}
-
-/// Nearest float not above (below) x, so float bounds contain the double box.
-float round_down(double x) {
-  const auto f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? float_step(f, true) : f;
-}
-float round_up(double x) {
-  const auto f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? float_step(f, false) : f;
-}
-
 double largest_side(const Box& b) {
   return (b.hi - b.lo).maxCoeff();
 }
@@ -111,15 +92,11 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
     j1 = b.cell(1, l, boxes[k].hi[v]);
   };
 
-  // Each box's float bounds, rounded outward: {lo_w, hi_w, lo_u, hi_u, lo_v, hi_v}.
+  // Each box's float bounds, rounded outward.
   const int wa = b.axis[2];
   std::vector<std::array<float, 6>> bounds(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      const Box& x = boxes[k];
-      bounds[k] = {round_down(x.lo[wa]), round_up(x.hi[wa]), round_down(x.lo[u]),
-                   round_up(x.hi[u]),    round_down(x.lo[v]), round_up(x.hi[v])};
-    }
+    for (size_t k = r.begin(); k != r.end(); ++k) bounds[k] = float_bounds(b, boxes[k]);
   });
 
   // Entries: one per (box, cell it spans); offsets by a parallel prefix sum.
@@ -161,15 +138,15 @@ SparseBucket build_sparse_bucket(std::span<const Box> boxes) {
   radix_sort(entries);
 
   const size_t m = entries.size();
-  b.entry_lo.resize(m);
-  b.entry_bounds.resize(m);
+  // The padding lanes: lo bounds +inf, hi bounds -inf.
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int k = 0; k < 6; ++k) b.entry_bound[k].assign(m + SparseBucket::kLanes, k % 2 == 0 ? inf : -inf);
   b.entry_box.resize(m);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, m), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k != r.end(); ++k) {
-      const auto& f = bounds[entries[k].id];
-      b.entry_lo[k] = f[0];
-      b.entry_bounds[k] = {f[1], f[2], f[3], f[4], f[5]};
-      b.entry_box[k] = entries[k].id;
+    for (size_t e = r.begin(); e != r.end(); ++e) {
+      const auto& f = bounds[entries[e].id];
+      for (int k = 0; k < 6; ++k) b.entry_bound[k][e] = f[k];
+      b.entry_box[e] = entries[e].id;
     }
   });
   const std::uint64_t mask_i = (std::uint64_t(1) << wi) - 1, mask_j = (std::uint64_t(1) << wj) - 1;
@@ -207,8 +184,7 @@ std::size_t memory_bytes(const SparseBucket& b) {
          (b.cell_size.capacity() + b.cell_inverse.capacity()) * sizeof(double) +
          b.level_cells.capacity() * sizeof(Index) + b.cell_key.capacity() * sizeof(std::uint64_t) +
          b.cell_entries.capacity() * sizeof(Index) + b.cell_max_extent.capacity() * sizeof(double) +
-         b.entry_lo.capacity() * sizeof(float) +
-         b.entry_bounds.capacity() * sizeof(std::array<float, 5>) +
+         6 * b.entry_bound[0].capacity() * sizeof(float) +
          b.entry_box.capacity() * sizeof(Index);
 }
 

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "contact/candidates.hpp"
@@ -316,6 +318,25 @@ TEST(SparseBucket, BoxesOnBucketBoundariesAreReportedExactlyOnce) {
     EXPECT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end())
         << "duplicate report";
     EXPECT_EQ(found, overlapping(boxes, q));
+  }
+}
+
+TEST(SparseBucket, FloatBoundsAreTheNearestFloatsOutside) {
+  // float_below(x) is the largest float <= x and float_above(x) the smallest
+  // >= x (std::nextafter's answer where the conversion rounds the wrong way),
+  // for doubles of either sign, zero, subnormal, and beyond the float range.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-160, 140);
+  std::vector<double> xs{0.0, -0.0, 1e-46, -1e-46, 1.0, -1.0, 0.1, -0.1, 3.5e38, -3.5e38, 1e300, -1e300};
+  for (int k = 0; k < 100000; ++k) xs.push_back(std::ldexp(mantissa(rng), exponent(rng)));
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const double x : xs) {
+    const float below = float_below(x), above = float_above(x);
+    ASSERT_LE(static_cast<double>(below), x) << x;
+    ASSERT_GE(static_cast<double>(above), x) << x;
+    ASSERT_GT(static_cast<double>(std::nextafter(below, inf)), x) << x;
+    ASSERT_LT(static_cast<double>(std::nextafter(above, -inf)), x) << x;
   }
 }
 
