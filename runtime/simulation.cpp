@@ -258,14 +258,15 @@ void Simulation::resolve_contact() {
   const std::vector<Index>& vertices = contact_vertices_;
   contact_dx_.resize(vertices.size());
   contact_dv_.resize(vertices.size());
-  for (size_t k = 0; k < vertices.size(); ++k) contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]];
+  const auto count = static_cast<Index>(vertices.size());
+  parallel_for_each(count, [&](Index k) { contact_dx_[k] = x_[vertices[k]], contact_dv_[k] = v_[vertices[k]]; });
   const DcrResult r =
       contact_->apply(x_prev_, x_, v_, inv_mass_, dt_, model_.bc_mask, rigid_ ? &rigid_->for_contact() : nullptr);
   if (rigid_) rigid_->apply_contact(r.rigid, dt_, x_, v_);
-  for (size_t k = 0; k < vertices.size(); ++k) {
+  parallel_for_each(count, [&](Index k) {
     contact_dx_[k] = x_[vertices[k]] - contact_dx_[k];
     contact_dv_[k] = v_[vertices[k]] - contact_dv_[k];
-  }
+  });
   step_work_[kContactDissipated] += r.dissipated;
   step_work_[kSupportWork] += r.support_work;
   step_work_[kContactWork] += r.work;
@@ -297,11 +298,11 @@ void Simulation::book_contact_work() {
   // (docs/contact.md, "The ledger with e < 1"); booked as contact_work, whatever the law.
   const double half = 0.5 * dt_;
   const std::vector<Index>& vertices = contact_vertices_;
-  for (size_t k = 0; k < vertices.size(); ++k) {
+  step_work_[kContactWork] += exact_sums<1>(static_cast<Index>(vertices.size()), [&](Index k, std::array<ExactSum, 1>& w) {
     const Index i = vertices[k];
     if (contact_dx_[k] != Vec3::Zero() || contact_dv_[k] != Vec3::Zero())
-      step_work_[kContactWork] += (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
-  }
+      w[0] += (f_ext_[i] - f_int_[i]).dot(contact_dx_[k] - half * contact_dv_[k]);
+  })[0];
 }
 
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
