@@ -104,8 +104,9 @@ inline int sparse_bucket_level(double h0, const Box& x) {
 }
 
 /// The nearest float not above (not below) x, so float bounds contain the
-/// double box (x finite; beyond the float range, -+FLT_MAX or -+inf). Written
-/// without branches: the step is taken or not with equal odds.
+/// double box; beyond the float range, float_below gives FLT_MAX or -inf and
+/// float_above +inf or -FLT_MAX. Written without branches: the step is taken
+/// or not with equal odds.
 inline float float_below(double x) {
   const auto f = static_cast<float>(x);
   const auto bits = std::bit_cast<std::uint32_t>(f);
