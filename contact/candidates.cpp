@@ -11,7 +11,6 @@
 #include <bit>
 
 #include "contact/radix_sort.hpp"
-
 #include "kernels/error.hpp"
 
 namespace shatter {
