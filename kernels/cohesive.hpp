@@ -15,43 +15,47 @@
 // so that T . dDelta = t d(delta) along any path. The state is the largest
 // effective opening reached, delta_max. The effective traction is
 //   loading   (delta >= delta_max): t = envelope(delta) = sigma_c <1 - delta / delta_c>,
-//   unloading (delta <  delta_max): t = envelope(delta_max) - K (delta_max - delta),
-//     K = min(k_p, envelope(delta_max) / delta_max)  (0 past delta_c),
-// delta_c = 2 Gc / sigma_c. The work of separation is the area under the
-// envelope, sigma_c delta_c / 2 = Gc (J/m^2), for every mode mixity.
+//   unloading (delta <  delta_max): t = envelope(delta_max) delta / delta_max,
+// the secant to the origin (Ortiz and Pandolfi), delta_c = 2 Gc / sigma_c.
+// Either way t / delta = envelope(delta_max) / delta_max: the point is a
+// linear spring whose stiffness the opening can only lower. The work of
+// separation is the area under the envelope, sigma_c delta_c / 2 = Gc
+// (J/m^2), for every mode mixity.
 //
-// Unloading: Ortiz and Pandolfi unload along the secant to the origin, whose
-// slope sigma_c / delta_max is unbounded as delta_max -> 0: a facet that
-// recloses just after insertion would be an arbitrarily stiff spring, which
-// no time step integrates (measured 10-100 x beyond the stability limit on
-// the fine expanding ring, docs/validation.md). Here the unloading slope K is
-// the secant where the secant is at most k_p (delta_max >= delta_u =
-// sigma_c / (k_p + sigma_c / delta_c)), so the law is Ortiz-Pandolfi's
-// there, and k_p below: a facet unloaded from a small delta_max still pulls
-// with t_0 = envelope(delta_max) - K delta_max > 0 at delta = 0, as it did
-// at insertion. So the traction is the sum of
+// Stability. The secant's slope envelope(delta_max) / delta_max is unbounded
+// as delta_max -> 0. With K = min(k_p, secant) the traction is the sum of
 //   (i)  a linear part K (beta^2 delta_s + <delta_n> n), of stiffness at most
 //        max(1, beta^2) k_p, plus the penalty k_p in compression: the
 //        stiffness the stable step includes (cohesive_stiffness_bound);
-//   (ii) a part of bounded size, |T_ii| <= max(1, beta) sigma_c: t_0 along
-//        the opening direction on unloading, the softening envelope on
-//        loading. A bounded force cannot grow a solution exponentially: near
-//        delta = 0 it makes the two sides chatter by at most about
-//        sigma_c A dt^2 / m (A the facet's area, m its nodes' mass), the
-//        elastic opening at the strength, and on loading it acts over an
-//        opening of at most delta_c and releases at most Gc per unit area.
-// At Delta = 0 (a facet just inserted: its two sides coincide) the direction
-// of the opening is undefined; the traction is t_0 n, the subgradient of the
-// cone phi ~ t_0 delta along the normal: the facet pulls with the strength
-// it broke at, so the bulk's work on the first opening is taken out as the
-// law's dissipation counts it (with 0 there, the ledger gained sigma_c
-// delta_1 per unit area at every insertion, delta_1 the first step's
-// opening: +0.6 % of the external work on the alumina bar). Closed in
-// compression (Delta = delta_n n, delta_n < 0) the cohesive part is 0.
+//   (ii) the rest, (secant - K) delta along the opening direction on
+//        unloading and the softening envelope less (i) on loading: at most
+//        envelope(delta_max) - K delta_max <= sigma_c, times max(1, beta).
+// Part (ii) is stiffer than the step resolves where delta_max < delta_u =
+// sigma_c / (k_p + sigma_c / delta_c), but it acts only while delta <=
+// delta_max and its force is bounded: an oscillation it excites cannot grow
+// past delta_max without loading the point (delta_max grows and the secant
+// falls), so it ends as damage, not as a growing solution.
+// Until session 19 the unloading slope was capped at k_p (a line t_0 + K
+// delta with t_0 > 0 at delta = 0, a cone at the origin): exact for energy
+// too, but its force flips wherever the opening passes the cone's tip, and a
+// closed point sheared back and forth by a passing wave (delta = beta
+// |delta_s| in compression) gained energy at every flip: 2.6 % of the
+// energy on the 1e3 /s structured ring, 0.35 % with the secant
+// (docs/validation.md, "Where the 1e3 /s ring's energy gain comes from").
+// The secant is linear on unloading, which central difference integrates
+// with no energy error (the trapezoid rule is exact for it).
+// At Delta = 0 with delta_max = 0 (a facet just inserted: its two sides
+// coincide) the direction of the opening is undefined; the traction is
+// sigma_c n, the subgradient of the cone phi ~ sigma_c delta along the normal:
+// the facet pulls with the strength it broke at, so the bulk's work on the
+// first opening is taken out as the law's dissipation counts it (with 0
+// there, the ledger gained sigma_c delta_1 per unit area at every insertion,
+// delta_1 the first step's opening: +0.6 % of the external work on the
+// alumina bar).
 //
 // Compression (delta_n < 0): the cohesive law acts on the shear part only
 // (delta = beta |delta_s|) and interpenetration is resisted by a linear normal
-// penalty T_n = k_p delta_n n with the same stiffness k_p (Pa/m): k_p = E / h
+// penalty T_n = k_p delta_n n with stiffness k_p (Pa/m): k_p = E / h
 // (runtime/fracture_stage.cpp), as stiff as the adjacent elements, not a
 // user knob. Crack faces that part meet through contact (DCR) once freed.
 //
@@ -68,11 +72,10 @@
 // has come apart is freed (release_debonded).
 //
 // Energies per unit reference area (J/m^2):
-//   stored     = t_0 delta + K delta^2 / 2 + k_p <-delta_n>^2 / 2
-//                (recoverable: the area under the unloading line, plus the penalty)
-//   dissipated = W(delta_max) - stored(delta_max)
-//              = (sigma_c / delta_c + K) delta_max^2 / 2 before delta_c
-//                (sigma_c delta_max / 2 on the secant branch), Gc past it,
+//   stored     = envelope(delta_max) delta^2 / (2 delta_max) + k_p <-delta_n>^2 / 2
+//                (recoverable: the triangle under the secant, plus the penalty)
+//   dissipated = W(delta_max) - stored(delta_max) = sigma_c delta_max / 2
+//                before delta_c, Gc past it,
 // where W(delta_max) is the area under the envelope up to delta_max.
 #include <algorithm>
 #include <cmath>
@@ -113,16 +116,15 @@ inline double cohesive_envelope(const CohesiveLaw& law, double delta) {
   return law.sigma_c * std::max(0.0, 1.0 - delta / law.delta_c);
 }
 
-/// Unloading slope from state delta_max, Pa/m: min(k_p, envelope / delta_max)
-/// (k_p at delta_max = 0), 0 past delta_c.
-inline double cohesive_unloading_stiffness(const CohesiveLaw& law, double delta_max) {
-  if (delta_max >= law.delta_c) return 0.0;
-  const double t = cohesive_envelope(law, delta_max);
-  return t < law.penalty * delta_max ? t / delta_max : law.penalty;
+/// Stiffness t / delta of a point in state delta_max, Pa/m: the secant
+/// envelope(delta_max) / delta_max (0 past delta_c), for loading and
+/// unloading alike. Unbounded as delta_max -> 0; only delta_max > 0.
+inline double cohesive_secant_stiffness(const CohesiveLaw& law, double delta_max) {
+  return cohesive_envelope(law, delta_max) / delta_max;
 }
 
 /// Upper bound of the stiffness of the linear part (i) of the traction, Pa/m:
-/// max(1, beta^2) k_p (the unloading slope K in every direction, and the
+/// max(1, beta^2) k_p (K = min(k_p, secant) in every direction, and the
 /// compression penalty). The rest of the traction is bounded by
 /// max(1, beta) sigma_c (see the top of this file).
 inline double cohesive_stiffness_bound(const CohesiveLaw& law) {
@@ -164,15 +166,13 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
     return {Vec3::Zero(), Vec3::Zero(), kPointApart, 0.0, law.fracture_energy()};
   const double dm = std::max(delta, delta_max);
   out.delta_max = dm;
-  const double K = cohesive_unloading_stiffness(law, dm);
-  const double t0 = dm < law.delta_c ? cohesive_envelope(law, dm) - K * dm : 0.0;  // t at delta = 0
-  const double t = t0 + K * delta;  // Pa; the envelope itself on loading (delta = dm)
-  const double t_over_delta = delta > 0 ? t / delta : 0.0;
+  // t / delta: the secant, for loading (delta = dm) and unloading alike.
+  const double t_over_delta = dm > 0 ? cohesive_secant_stiffness(law, dm) : 0.0;
   out.traction = t_over_delta * (beta2 * delta_s + open_n * n);
-  // Closed (Delta = 0: a facet just inserted, its sides still together): t_0
-  // along the normal, the traction it carried at the strength.
-  if (delta_n == 0 && delta == 0) out.traction = t0 * n;
-  out.stored = delta * (t0 + 0.5 * K * delta);
+  // Just inserted (Delta = 0, no state: its sides still together): the
+  // traction it carried at the strength, along the normal.
+  if (dm == 0 && delta_n == 0) out.traction = law.sigma_c * n;
+  out.stored = 0.5 * t_over_delta * delta * delta;
   // phi(Delta, n) depends on n through delta_n = Delta . n and |delta_s|^2 =
   // |Delta|^2 - delta_n^2: dphi/dn = (t/delta (<delta_n> - beta^2 delta_n)
   // + k_p min(delta_n, 0)) Delta.
@@ -185,8 +185,7 @@ inline CohesiveTraction cohesive_traction(const CohesiveLaw& law, const Vec3& op
   out.dphi_dn = c * opening;
   // Past delta_c and not compressed: no traction (t = 0) and no penalty now, none from now on.
   if (dm >= law.delta_c && delta_n >= 0) out.delta_max = kPointApart;
-  out.dissipated = dm >= law.delta_c ? law.fracture_energy()
-                                     : 0.5 * (law.sigma_c / law.delta_c + K) * dm * dm;
+  out.dissipated = dm >= law.delta_c ? law.fracture_energy() : 0.5 * law.sigma_c * dm;
   return out;
 }
 

@@ -315,8 +315,8 @@ TEST(CohesiveForces, ForcesAreEqualAndOpposite) {
 TEST(CohesiveForces, EigenvalueBoundHoldsAndIsTight) {
   // The stiffness K of the cohesive forces by central differences on two
   // elements joined by one cohesive facet, unloading from delta_max =
-  // delta_u, where the unloading slope is k_p and the bounded part of the
-  // traction vanishes (kernels/cohesive.hpp), in tension and in compression:
+  // delta_u, where the secant is k_p and the bounded part of the traction
+  // vanishes (kernels/cohesive.hpp), in tension and in compression:
   // the largest eigenvalue of M^-1/2 K M^-1/2 stays below
   // cohesive_eigenvalue_bound, which the stable step adds to the elements'
   // omega^2, and the bound is not loose.
