@@ -91,7 +91,7 @@ struct CohesiveLaw {
   double sigma_c = 0;  ///< cohesive strength, Pa
   double delta_c = 0;  ///< critical effective opening 2 Gc / sigma_c, m
   double beta = 1;     ///< shear-to-normal weighting, dimensionless
-  double penalty = 0;  ///< k_p, Pa/m: the steepest unloading slope and the normal stiffness in compression
+  double penalty = 0;  ///< k_p, Pa/m: the normal stiffness in compression, and the split of the secant (top of this file)
 
   /// Fracture energy Gc = sigma_c delta_c / 2, J/m^2.
   double fracture_energy() const { return 0.5 * sigma_c * delta_c; }
