@@ -26,10 +26,12 @@
 #          one whose RUN_DIR/name exists without it: another invocation runs
 #          it, or it failed (see its stderr.txt); so two invocations, one
 #          with REVERSE=1 (the list backwards), share the cases on 2 cores;
-#          ONLY="name ..." runs only those; RUN_ONLY=1 / ANALYSE_ONLY=1)
-# Output:  bench/results/expanding_ring_structured.csv,
-#          docs/plots/expanding_ring_structured.png,
-#          docs/plots/expanding_ring_structured_distribution.png, tables on stdout.
+#          ONLY="name ..." runs only those; RUN_ONLY=1 / ANALYSE_ONLY=1;
+#          SUFFIX=_x appends _x to the CSV's and the plots' names, for a
+#          series run with another law or build)
+# Output:  bench/results/expanding_ring_structured${SUFFIX}.csv,
+#          docs/plots/expanding_ring_structured${SUFFIX}.png,
+#          docs/plots/expanding_ring_structured${SUFFIX}_distribution.png, tables on stdout.
 # Every run niced (nice -n 15), one thread.
 set -euo pipefail
 build=${1:?usage: expanding_ring_structured.sh BUILD_DIR [RUN_DIR]}
@@ -129,5 +131,5 @@ EOF
 done
 [ -n "${RUN_ONLY:-}" ] && exit 0
 
-/usr/bin/python3 "$here/expanding_ring_analysis.py" "$runs" "$here/results/expanding_ring_structured.csv" \
-  "$root/docs/plots/expanding_ring_structured" u0.05 "${analysis_cases[@]}"
+/usr/bin/python3 "$here/expanding_ring_analysis.py" "$runs" "$here/results/expanding_ring_structured${SUFFIX:-}.csv" \
+  "$root/docs/plots/expanding_ring_structured${SUFFIX:-}" u0.05 "${analysis_cases[@]}"
