@@ -239,7 +239,7 @@ TEST(CohesiveLaw, ReclosedPointSettlesUnderCentralDifference) {
   // kernels/cohesive.hpp: its force is bounded, so central difference flings
   // the point by at most about one kick, max(1, beta) sigma_c dt^2 / mu, the
   // point loads, its secant falls to what the step resolves, and it stays
-  // there. With the capped slope (sessions 9-18) the cone kept kicking: up to
+  // there. With the capped slope used before session 19 the cone kept kicking: up to
   // 1.76 kicks, and delta_max grew by 58 % after the first 100 steps (beta 2).
   const double sigma_c = 3.0e6, gc = 40.0, delta_c = 2 * gc / sigma_c;
   for (double beta : {0.5, 1.0, 2.0})
