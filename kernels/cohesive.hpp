@@ -34,7 +34,8 @@
 // sigma_c / (k_p + sigma_c / delta_c), but it acts only while delta <=
 // delta_max and its force is bounded: an oscillation it excites cannot grow
 // past delta_max without loading the point (delta_max grows and the secant
-// falls), so it ends as damage, not as a growing solution.
+// falls), so it ends as damage, not as a growing solution
+// (CohesiveLaw.ReclosedPointSettlesUnderCentralDifference).
 // Until session 19 the unloading slope was capped at k_p (a line t_0 + K
 // delta with t_0 > 0 at delta = 0, a cone at the origin): exact for energy
 // too, but its force flips wherever the opening passes the cone's tip, and a
