@@ -25,6 +25,18 @@ DcrPairKind dcr_kind(const ContactPair& p) {
   return p.kind == ContactPair::VertexFace ? DcrPairKind::VertexFace : DcrPairKind::EdgeEdge;
 }
 
+/// Pairs per chunk of a detection round.
+constexpr size_t kDetectChunk = 256;
+
+/// What a chunk of a detection round found: the pairs of mine (indices) whose swept boxes
+/// overlap (first round), those penetrating, the pairs checked, and the first pair with a node
+/// beyond the nodal arrays (-1: none).
+struct DetectChunk {
+  std::vector<Index> kept, penetrating;
+  Index detected = 0;
+  Index bad = -1;
+};
+
 /// What resolving one found pair did.
 struct Outcome {
   bool active = false;
@@ -219,11 +231,6 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
   SHATTER_REQUIRE(scratch.gaps.empty() || (scratch.gaps.size() == mine.size() && scratch.drift.size() >= n_nodes),
                   "resolve_contacts: " << scratch.gaps.size() << " gaps for " << mine.size() << " pairs, "
                                        << scratch.drift.size() << " drifts for " << n_nodes << " nodes");
-  for (size_t i = 0; i < mine.size(); ++i)
-    for (const Index n : mine[i].nodes)
-      SHATTER_REQUIRE(n >= 0 && static_cast<size_t>(n) < n_nodes, "resolve_contacts: node " << n << " of pair " << i
-                                                                                            << " beyond the " << n_nodes
-                                                                                            << " nodal values");
   const DcrLaw law{options.restitution, options.friction, options.gap, options.placement};
   if (scratch.moved.size() < n_nodes) scratch.moved.resize(n_nodes, 0);
   if (scratch.slot.size() < n_nodes) scratch.slot.resize(n_nodes, -1);
@@ -249,20 +256,28 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
     const long stamp = ++scratch.stamp;
     const size_t n_check = first_round ? mine.size() : kept.size();
     auto checked = [&](size_t k) { return first_round ? static_cast<Index>(k) : kept[k]; };
-    std::vector<std::uint8_t> hit(n_check, 0);
+    // Detection and its lists in fixed chunks, concatenated in chunk order below (the same
+    // lists whatever the threads; collected serially, they were 3 % of a one-rank run).
     const bool screen = first_round && !scratch.gaps.empty();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n_check, 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t k = r.begin(); k != r.end(); ++k) {
-        const ContactPair& p = mine[checked(k)];
+    const size_t chunks = (n_check + kDetectChunk - 1) / kDetectChunk;
+    std::vector<DetectChunk> chunk(chunks);
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t at) {
+      DetectChunk& out = chunk[at];
+      for (size_t k = at * kDetectChunk; k < std::min(n_check, (at + 1) * kDetectChunk); ++k) {
+        const Index i = checked(k);
+        const ContactPair& p = mine[i];
+        // (the nodes of mine are checked in the first round, before anything reads them)
+        if (first_round && std::any_of(p.nodes.begin(), p.nodes.end(),
+                                       [&](Index n) { return n < 0 || static_cast<size_t>(n) >= n_nodes; })) {
+          if (out.bad < 0) out.bad = i;
+          continue;
+        }
         if (screen) {
           const std::span<const double> d = scratch.drift;
           const bool vf = p.kind == ContactPair::VertexFace;
           const double a = vf ? d[p.nodes[0]] : std::max(d[p.nodes[0]], d[p.nodes[1]]);
           const double b = vf ? std::max({d[p.nodes[1]], d[p.nodes[2]], d[p.nodes[3]]}) : std::max(d[p.nodes[2]], d[p.nodes[3]]);
-          if (scratch.gaps[k] > kGapDrift * (a + b)) {
-            hit[k] = 3;  // its swept boxes are apart (DcrScratch::gaps)
-            continue;
-          }
+          if (scratch.gaps[k] > kGapDrift * (a + b)) continue;  // its swept boxes are apart (DcrScratch::gaps)
         }
         if (!first_round &&
             std::none_of(p.nodes.begin(), p.nodes.end(), [&](Index n) { return scratch.moved[n] == previous; }))
@@ -273,27 +288,33 @@ DcrResult resolve_contacts(std::span<const ContactPair> mine, std::span<Vec3> x_
           X_new.col(c) = x_new[p.nodes[c]];
         }
         const PairThickness th = pair_thickness(p, surface);
-        if (first_round && !pair_boxes_overlap(p.kind, X_old, X_new, th.reach)) {
-          hit[k] = 3;
-          continue;
-        }
+        if (first_round && !pair_boxes_overlap(p.kind, X_old, X_new, th.reach)) continue;
+        if (first_round) out.kept.push_back(i);
+        ++out.detected;
         const auto normals = [&] { return pair_normals(p, surface, tn); };
-        hit[k] = distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals, th).penetrating ? 2 : 1;
+        if (distinct_nodes(p) && dcr_detect(dcr_kind(p), X_old, X_new, normals, th).penetrating)
+          out.penetrating.push_back(i);
       }
     });
+    for (const DetectChunk& out : chunk)
+      if (out.bad >= 0)
+        for (const Index n : mine[out.bad].nodes)
+          SHATTER_REQUIRE(n >= 0 && static_cast<size_t>(n) < n_nodes, "resolve_contacts: node "
+                                                                          << n << " of pair " << out.bad << " beyond the "
+                                                                          << n_nodes << " nodal values");
     std::vector<FoundPair> found;
     std::vector<DcrKey> keys;
     if (first_round) kept.clear();
-    for (size_t k = 0; k < n_check; ++k) {
-      const ContactPair& p = mine[checked(k)];
-      if (hit[k] == 2) {
+    for (const DetectChunk& out : chunk) {
+      for (const Index i : out.penetrating) {
+        const ContactPair& p = mine[i];
         found.push_back({p, pair_normals(p, surface, tn)});
         std::array<std::uint64_t, 4> ids;
         for (int c = 0; c < 4; ++c) ids[c] = ranks ? ranks->id(p.nodes[c]) : static_cast<std::uint64_t>(p.nodes[c]);
         keys.push_back(dcr_key(p.kind, ids, result.sweeps));
       }
-      if (first_round && hit[k] != 3) kept.push_back(checked(k));
-      result.detected += hit[k] == 1 || hit[k] == 2;
+      if (first_round) kept.insert(kept.end(), out.kept.begin(), out.kept.end());
+      result.detected += out.detected;
     }
     first_round = false;
     ++result.sweeps;
