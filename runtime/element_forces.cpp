@@ -1,8 +1,12 @@
 #include "runtime/element_forces.hpp"
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_for_each.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "kernels/tet10.hpp"
@@ -152,6 +156,38 @@ void ElementForces::split_phases(const std::vector<char>& late) {
     for (const Index b : coloring_.items_of(c)) phase_items_[late[b] ? 1 : 0].push_back(b);
     for (int p = 0; p < 2; ++p) phase_offsets_[p].push_back(static_cast<Index>(phase_items_[p].size()));
   }
+  // Each phase's graph: walking its blocks in color order, a block follows the last block
+  // that touched each of its nodes (blocks of one color share no node).
+  const Mesh& mesh = model_.mesh;
+  const int k = mesh.nodes_per_element();
+  std::vector<Index> last(mesh.num_nodes(), -1);
+  for (int p = 0; p < 2; ++p) {
+    const std::vector<Index>& items = phase_items_[p];
+    const Index n = static_cast<Index>(items.size());
+    std::vector<std::vector<Index>> after(n);
+    std::vector<Index> seen(n, -1);
+    BlockGraph& g = graphs_[p];
+    g = {};
+    g.waits.assign(n, 0);
+    for (Index i = 0; i < n; ++i) {
+      const Index b = items[i];
+      for (Index j = subset_offsets_[b]; j < subset_offsets_[b + 1]; ++j)
+        for (int a = 0; a < k; ++a) {
+          Index& before = last[mesh.element(subset_[j])[a]];
+          if (before >= 0 && before != i && seen[before] != i) seen[before] = i, after[before].push_back(i), ++g.waits[i];
+          before = i;
+        }
+    }
+    for (Index b : items)
+      for (Index j = subset_offsets_[b]; j < subset_offsets_[b + 1]; ++j)
+        for (int a = 0; a < k; ++a) last[mesh.element(subset_[j])[a]] = -1;
+    g.successor_offsets.assign(1, 0);
+    for (Index i = 0; i < n; ++i) {
+      if (g.waits[i] == 0) g.first.push_back(i);
+      g.successors.insert(g.successors.end(), after[i].begin(), after[i].end());
+      g.successor_offsets.push_back(static_cast<Index>(g.successors.size()));
+    }
+  }
 }
 
 void ElementForces::restrict_to(std::span<const Index> elements, std::span<const Index> nodes,
@@ -278,15 +314,25 @@ ElementLoopResult ElementForces::compute(std::span<const Vec3> x, std::span<Vec3
     block_worst_[b] = worst;
   };
 
+  const bool one_thread =
+      std::min<std::size_t>(tbb::this_task_arena::max_concurrency(),
+                            tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)) == 1;
   for (int p = 0; p < 2; ++p) {
     if (p == 1 && between) between();
     const std::vector<Index>& items = phase_items_[p];
-    const std::vector<Index>& offsets = phase_offsets_[p];
-    for (int c = 0; c < coloring_.num_colors(); ++c)
-      tbb::parallel_for(tbb::blocked_range<Index>(offsets[c], offsets[c + 1], 1),
-                        [&](const tbb::blocked_range<Index>& r) {
-                          for (Index i = r.begin(); i < r.end(); ++i) run_block(items[i]);
-                        });
+    if (one_thread) {
+      for (const Index b : items) run_block(b);  // color order
+      continue;
+    }
+    // A block runs when its predecessors have (their counts reset each step).
+    const BlockGraph& g = graphs_[p];
+    std::vector<std::atomic<int>> waiting(items.size());
+    for (size_t i = 0; i < items.size(); ++i) waiting[i].store(g.waits[i], std::memory_order_relaxed);
+    tbb::parallel_for_each(g.first.begin(), g.first.end(), [&](Index i, tbb::feeder<Index>& feeder) {
+      run_block(items[i]);
+      for (Index s = g.successor_offsets[i]; s < g.successor_offsets[i + 1]; ++s)
+        if (waiting[g.successors[s]].fetch_sub(1, std::memory_order_acq_rel) == 1) feeder.add(g.successors[s]);
+    });
   }
 
   ElementLoopResult res;

@@ -1,10 +1,11 @@
 #pragma once
 // Executor of the bulk element loop (STYLE.md level 3): elements are cut into
 // consecutive blocks, blocks that share a node get different colors, and the
-// blocks of one color run as oneTBB tasks, each scattering its elements'
-// forces straight into the nodal array. A node receives its contributions in
-// a fixed order (color, block, element), so forces are bitwise identical for
-// any thread count.
+// blocks run as oneTBB tasks, each scattering its elements' forces straight
+// into the nodal array. A block waits only for the blocks of lower colors that
+// share a node with it (a graph of blocks, not a barrier per color), so a node
+// receives its contributions in a fixed order (color, element), and forces are
+// bitwise identical for any thread count.
 //
 // Under MPI (runtime/decomposition.hpp) a rank computes only a subset of the
 // elements (its owned granules and its ghost layer) with the SAME blocks and
@@ -100,6 +101,14 @@ class ElementForces {
   std::vector<Index> zero_nodes_;               ///< nodes to zero after restrict_to (empty: all)
   /// Per phase (early, late): the blocks in color order, CSR by color.
   std::array<std::vector<Index>, 2> phase_items_, phase_offsets_;
+  /// Per phase, its blocks (positions in phase_items_) as a graph: a block's successors are the
+  /// blocks of the phase that next touch one of its nodes, by color (CSR); `waits` counts each
+  /// block's predecessors, `first` lists the blocks with none.
+  struct BlockGraph {
+    std::vector<Index> first, successor_offsets, successors;
+    std::vector<int> waits;
+  };
+  std::array<BlockGraph, 2> graphs_;
   mutable std::vector<double> granule_energy_;  ///< per granules_
   mutable std::vector<double> block_dt_, block_min_J_;
   mutable std::vector<Index> block_worst_;
