@@ -209,7 +209,8 @@ void Simulation::step() {
   check_ledger();
 }
 
-void Simulation::half_kick(bool predicting) {
+template <class Then>
+void Simulation::half_kick(bool predicting, Then then) {
   const double half = 0.5 * dt_, end = time_ + dt_;
   const std::vector<BoundaryConditionSpec>& conditions = model_.scene.boundary_conditions;
   bc_factor_.resize(conditions.size());
@@ -230,20 +231,27 @@ void Simulation::half_kick(bool predicting) {
                          ? (model_.mesh.reference[i][c] + value - x_[i][c]) / dt_
                          : value;
         }
+    then(i);
   });
 }
 
 void Simulation::predict() {
-  half_kick(true);
-  bc_dx_.resize(bc_nodes_.size());
-  for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
-  if (contact_) x_prev_ = x_;
   if (loads_) {
     load_x_old_.resize(loads_->nodes().size());
     for (size_t k = 0; k < load_x_old_.size(); ++k) load_x_old_[k] = x_[loads_->nodes()[k]];
     load_force_old_ = loads_->force();
   }
-  dec_->for_touched(model_.mesh.num_nodes(), [&](Index i) { x_[i] += dt_ * v_[i]; });
+  // x(n) for contact: on one rank the pass below keeps it; on several, every node held here.
+  const bool keep = contact_ && !dec_->distributed();
+  if (contact_ && keep) x_prev_.resize(x_.size());
+  if (contact_ && !keep) x_prev_ = x_;
+  // The kick and the drift in one pass over the nodes.
+  half_kick(true, [&](Index i) {
+    if (keep) x_prev_[i] = x_[i];
+    x_[i] += dt_ * v_[i];
+  });
+  bc_dx_.resize(bc_nodes_.size());
+  for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
   if (rigid_) {
     rigid_->predict(dt_, x_, v_);
     // A spinning prescribed body's nodes: their conditions hold the translation, the
@@ -306,7 +314,7 @@ void Simulation::book_contact_work() {
 }
 
 void Simulation::correct(const std::vector<Vec3>& reaction_old) {
-  half_kick(false);
+  half_kick(false, [](Index) {});
   if (rigid_) rigid_->correct(dt_, x_, v_);
   // The reactions' work. Their part f_int - f_ext (reaction_) by the
   // trapezoidal rule, W += (R(n) + R(n+1))/2 . dx; their inertial part m a,

@@ -134,7 +134,9 @@ class Simulation {
   /// mid step (`predicting`: a velocity times its amplitude there, or the
   /// velocity that reaches a displacement times its amplitude at the end of
   /// the step) or at the end (a velocity, or a displacement's rate, there).
-  void half_kick(bool predicting);
+  /// then(i) runs on each node after its kick, in the same pass.
+  template <class Then>
+  void half_kick(bool predicting, Then then);
   /// half_kick, then x(n+1) = x(n) + dt v(n+1/2); keeps x(n) for contact and
   /// the prescribed nodes' displacements for the reactions' work.
   void predict();
