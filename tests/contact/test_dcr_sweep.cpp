@@ -476,4 +476,20 @@ TEST(DcrSweep, RejectsInconsistentInput) {
   EXPECT_THROW(resolve_contacts(s.pairs, s.x_new, s.x_old, s.v, short_inv_mass, 1.0, {}, {}, scratch), Error);
   const ContactPairs beyond{{ContactPair::VertexFace, {0, 1, 2, static_cast<Index>(s.x_new.size())}}};
   EXPECT_THROW(resolve_contacts(beyond, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {}, scratch), Error);
+  // A bad pair after many good ones (the check runs in the detection's chunks): named by its
+  // index, and no state changed.
+  ASSERT_FALSE(s.pairs.empty());
+  ContactPairs many;
+  while (many.size() < 1000) many.insert(many.end(), s.pairs.begin(), s.pairs.end());
+  const size_t bad = many.size();
+  many.push_back({ContactPair::EdgeEdge, {0, -1, 2, 3}});
+  const std::vector<Vec3> x_new = s.x_new, v = s.v;
+  try {
+    resolve_contacts(many, s.x_new, s.x_old, s.v, s.inv_mass, 1.0, {}, {}, scratch);
+    ADD_FAILURE() << "no error for a node of -1";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("node -1 of pair " + std::to_string(bad)), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(s.x_new, x_new);
+  EXPECT_EQ(s.v, v);
 }
