@@ -148,20 +148,15 @@ void ElementForces::set_subset(std::span<const Index> elements) {
 }
 
 void ElementForces::split_phases(const std::vector<char>& late) {
-  for (int p = 0; p < 2; ++p) {
-    phase_items_[p].clear();
-    phase_offsets_[p].assign(1, 0);
-  }
-  for (int c = 0; c < coloring_.num_colors(); ++c) {
+  for (int p = 0; p < 2; ++p) phase_items_[p].clear();
+  for (int c = 0; c < coloring_.num_colors(); ++c)
     for (const Index b : coloring_.items_of(c)) phase_items_[late[b] ? 1 : 0].push_back(b);
-    for (int p = 0; p < 2; ++p) phase_offsets_[p].push_back(static_cast<Index>(phase_items_[p].size()));
-  }
   // Each phase's graph: walking its blocks in color order, a block follows the last block
   // that touched each of its nodes (blocks of one color share no node).
   const Mesh& mesh = model_.mesh;
   const int k = mesh.nodes_per_element();
-  std::vector<Index> last(mesh.num_nodes(), -1);
   for (int p = 0; p < 2; ++p) {
+    std::vector<Index> last(mesh.num_nodes(), -1);
     const std::vector<Index>& items = phase_items_[p];
     const Index n = static_cast<Index>(items.size());
     std::vector<std::vector<Index>> after(n);
@@ -178,9 +173,6 @@ void ElementForces::split_phases(const std::vector<char>& late) {
           before = i;
         }
     }
-    for (Index b : items)
-      for (Index j = subset_offsets_[b]; j < subset_offsets_[b + 1]; ++j)
-        for (int a = 0; a < k; ++a) last[mesh.element(subset_[j])[a]] = -1;
     g.successor_offsets.assign(1, 0);
     for (Index i = 0; i < n; ++i) {
       if (g.waits[i] == 0) g.first.push_back(i);

@@ -99,8 +99,8 @@ class ElementForces {
   Coloring coloring_;  ///< of blocks_: the whole model's coloring
   std::vector<Index> subset_offsets_, subset_;  ///< CSR per block: its elements to compute
   std::vector<Index> zero_nodes_;               ///< nodes to zero after restrict_to (empty: all)
-  /// Per phase (early, late): the blocks in color order, CSR by color.
-  std::array<std::vector<Index>, 2> phase_items_, phase_offsets_;
+  /// Per phase (early, late): the blocks in color order.
+  std::array<std::vector<Index>, 2> phase_items_;
   /// Per phase, its blocks (positions in phase_items_) as a graph: a block's successors are the
   /// blocks of the phase that next touch one of its nodes, by color (CSR); `waits` counts each
   /// block's predecessors, `first` lists the blocks with none.

@@ -243,8 +243,8 @@ void Simulation::predict() {
   }
   // x(n) for contact: on one rank the pass below keeps it; on several, every node held here.
   const bool keep = contact_ && !dec_->distributed();
-  if (contact_ && keep) x_prev_.resize(x_.size());
-  if (contact_ && !keep) x_prev_ = x_;
+  if (keep) x_prev_.resize(x_.size());
+  else if (contact_) x_prev_ = x_;
   // The kick and the drift in one pass over the nodes.
   half_kick(true, [&](Index i) {
     if (keep) x_prev_[i] = x_[i];
