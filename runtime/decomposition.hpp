@@ -160,8 +160,9 @@ class Decomposition {
   DecompositionStats stats() const;
 
   /// In place: every rank's accumulators become their sum over the ranks
-  /// (exact; ~570 bytes per accumulator, whatever the model).
-  void sum(std::span<ExactSum> values) const;
+  /// (exact; ~570 bytes per accumulator, whatever the model), and every rank's
+  /// `most` their element-wise maxima, in the same message.
+  void sum(std::span<ExactSum> values, std::span<long> most = {}) const;
   /// Bytes one sum() of `count` accumulators sends per rank.
   static std::size_t sum_bytes(std::size_t count) { return count * (sizeof(std::int64_t) * ExactSum::kDigits + 8); }
   /// In place: `root`'s values on every rank.
@@ -188,6 +189,9 @@ class Decomposition {
   double min(double value) const;
   /// In place: the element-wise global minima.
   void min(std::span<double> values) const;
+  /// The same, and in the same message the least (key, index) pair over the
+  /// ranks: the smallest key, then the smallest index (MPI's MINLOC order).
+  void min(std::span<double> values, std::pair<double, long>& least) const;
   /// In place: the element-wise global maxima.
   void max(std::span<double> values) const;
   /// The smallest rank holding the global minimum of `value`.

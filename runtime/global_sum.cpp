@@ -1,55 +1,103 @@
 #include "runtime/global_sum.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <vector>
 
 namespace shatter {
 
 namespace {
 
-/// The accumulators' digits (normalized) and specials, packed for MPI.
-void pack(std::span<ExactSum> acc, std::vector<std::int64_t>& digits, std::vector<double>& specials) {
-  digits.resize(acc.size() * ExactSum::kDigits);
-  specials.resize(acc.size());
+// The message, in 64-bit words: the number of maxima M, then each accumulator's
+// kDigits digits (normalized) and its special (a double's bits), then the M maxima.
+// It is one element of its own contiguous type, so the operation sees it whole.
+constexpr int kWords = ExactSum::kDigits + 1;
+
+std::vector<std::int64_t> pack(std::span<ExactSum> acc, std::span<const long> most) {
+  std::vector<std::int64_t> words(1 + acc.size() * kWords + most.size());
+  words[0] = static_cast<std::int64_t>(most.size());
   for (size_t k = 0; k < acc.size(); ++k) {
     acc[k].normalize();
     const auto d = acc[k].digits();
-    std::copy(d.begin(), d.end(), digits.begin() + k * ExactSum::kDigits);
-    specials[k] = acc[k].special();
+    std::int64_t* at = words.data() + 1 + k * kWords;
+    std::copy(d.begin(), d.end(), at);
+    at[ExactSum::kDigits] = std::bit_cast<std::int64_t>(acc[k].special());
+  }
+  std::copy(most.begin(), most.end(), words.end() - static_cast<std::ptrdiff_t>(most.size()));
+  return words;
+}
+
+void unpack(const std::vector<std::int64_t>& words, std::span<ExactSum> acc, std::span<long> most) {
+  for (size_t k = 0; k < acc.size(); ++k) {
+    const std::int64_t* at = words.data() + 1 + k * kWords;
+    const auto d = acc[k].digits();
+    std::copy(at, at + ExactSum::kDigits, d.begin());
+    acc[k].set_special(std::bit_cast<double>(at[ExactSum::kDigits]));
+    acc[k].normalize();
+  }
+  std::copy(words.end() - static_cast<std::ptrdiff_t>(most.size()), words.end(), most.begin());
+}
+
+// Digits add as integers (normalized digits add without overflow), specials as
+// doubles (only 0, infinities and NaN: any order gives the same), maxima as maxima.
+void combine(void* in, void* inout, int* len, MPI_Datatype* type) {
+  int bytes = 0;
+  MPI_Type_size(*type, &bytes);
+  const auto words = static_cast<size_t>(bytes) / sizeof(std::int64_t);
+  for (int e = 0; e < *len; ++e) {
+    const std::int64_t* a = static_cast<const std::int64_t*>(in) + e * words;
+    std::int64_t* b = static_cast<std::int64_t*>(inout) + e * words;
+    const auto most = static_cast<size_t>(a[0]);
+    const size_t count = (words - 1 - most) / kWords;
+    for (size_t k = 0; k < count; ++k) {
+      const std::int64_t* x = a + 1 + k * kWords;
+      std::int64_t* y = b + 1 + k * kWords;
+      for (int i = 0; i < ExactSum::kDigits; ++i) y[i] += x[i];
+      y[ExactSum::kDigits] = std::bit_cast<std::int64_t>(std::bit_cast<double>(x[ExactSum::kDigits]) +
+                                                         std::bit_cast<double>(y[ExactSum::kDigits]));
+    }
+    for (size_t i = words - most; i < words; ++i) b[i] = std::max(a[i], b[i]);
   }
 }
 
-void unpack(std::span<ExactSum> acc, const std::vector<std::int64_t>& digits, const std::vector<double>& specials) {
-  for (size_t k = 0; k < acc.size(); ++k) {
-    const auto d = acc[k].digits();
-    std::copy(digits.begin() + k * ExactSum::kDigits, digits.begin() + (k + 1) * ExactSum::kDigits, d.begin());
-    acc[k].set_special(specials[k]);
-    acc[k].normalize();
-  }
+MPI_Op combine_op() {
+  static const MPI_Op op = [] {
+    MPI_Op made;
+    MPI_Op_create(&combine, 1, &made);
+    return made;
+  }();
+  return op;
 }
+
+/// The message's type: its words as one element.
+struct MessageType {
+  explicit MessageType(size_t words) {
+    MPI_Type_contiguous(static_cast<int>(words), MPI_INT64_T, &type);
+    MPI_Type_commit(&type);
+  }
+  ~MessageType() { MPI_Type_free(&type); }
+  MessageType(const MessageType&) = delete;
+  MessageType& operator=(const MessageType&) = delete;
+  MPI_Datatype type;
+};
 
 }  // namespace
 
-void allreduce(std::span<ExactSum> acc, MPI_Comm comm) {
-  std::vector<std::int64_t> digits;
-  std::vector<double> specials;
-  pack(acc, digits, specials);
-  MPI_Allreduce(MPI_IN_PLACE, digits.data(), static_cast<int>(digits.size()), MPI_INT64_T, MPI_SUM, comm);
-  MPI_Allreduce(MPI_IN_PLACE, specials.data(), static_cast<int>(specials.size()), MPI_DOUBLE, MPI_SUM, comm);
-  unpack(acc, digits, specials);
+void allreduce(std::span<ExactSum> acc, MPI_Comm comm, std::span<long> most) {
+  static_assert(sizeof(long) == sizeof(std::int64_t));
+  std::vector<std::int64_t> words = pack(acc, most);
+  const MessageType message(words.size());
+  MPI_Allreduce(MPI_IN_PLACE, words.data(), 1, message.type, combine_op(), comm);
+  unpack(words, acc, most);
 }
 
 void reduce_to_root(std::span<ExactSum> acc, MPI_Comm comm, int root) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  std::vector<std::int64_t> digits, out;
-  std::vector<double> specials, out_specials;
-  pack(acc, digits, specials);
-  if (rank == root) out.resize(digits.size()), out_specials.resize(specials.size());
-  MPI_Reduce(digits.data(), out.data(), static_cast<int>(digits.size()), MPI_INT64_T, MPI_SUM, root, comm);
-  MPI_Reduce(specials.data(), out_specials.data(), static_cast<int>(specials.size()), MPI_DOUBLE, MPI_SUM, root,
-             comm);
-  if (rank == root) unpack(acc, out, out_specials);
+  std::vector<std::int64_t> words = pack(acc, {}), out(rank == root ? words.size() : 0);
+  const MessageType message(words.size());
+  MPI_Reduce(words.data(), out.data(), 1, message.type, combine_op(), root, comm);
+  if (rank == root) unpack(out, acc, {});
 }
 
 }  // namespace shatter

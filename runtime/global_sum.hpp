@@ -2,7 +2,9 @@
 // Global sums of ExactSum accumulators over MPI ranks (kernels/exact_sum.hpp):
 // integer sums of the digits, so the result does not depend on the number of
 // ranks or on which rank added which term. Constant size: ~570 bytes per
-// accumulator, whatever the model.
+// accumulator, whatever the model. One message per reduction: the digits, the
+// specials (infinities, NaN) and any maxima travel together, through one
+// user-defined operation.
 #include <mpi.h>
 
 #include <span>
@@ -11,9 +13,10 @@
 
 namespace shatter {
 
-/// Every rank's accumulators summed, on every rank (collective over `comm`).
-void allreduce(std::span<ExactSum> accumulators, MPI_Comm comm);
-/// The same, the result on `root` only (the others' are left as they were).
+/// Every rank's accumulators summed, and every rank's `most` replaced by the
+/// element-wise maxima over the ranks, on every rank (collective over `comm`).
+void allreduce(std::span<ExactSum> accumulators, MPI_Comm comm, std::span<long> most = {});
+/// The sums only, the result on `root` only (the others' are left as they were).
 void reduce_to_root(std::span<ExactSum> accumulators, MPI_Comm comm, int root = 0);
 
 }  // namespace shatter

@@ -115,24 +115,21 @@ void Simulation::compute_forces(long step, double time, const std::function<void
   // With cohesive elements the stable step also bounds their stiffness:
   // 2 / sqrt(omega_e^2 + lambda_c), both over the whole model.
   double dt_bound[2] = {std::min(last_elements_.stable_dt, last_shells_.stable_dt), fracture_ ? -fracture_->eigenvalue_bound(model_.mass) : 0.0};
-  dec_->min(dt_bound);
+  if (dec_->distributed()) {
+    // With the bounds' minima, the worst element over all ranks (NaN first, then the
+    // smallest det F, then the smallest index, as on one rank), by the whole model's
+    // element index (a part's local ones differ): one message.
+    constexpr long kNone = std::numeric_limits<int>::max();
+    std::pair<double, long> worst{
+        std::isnan(last_elements_.min_jacobian) ? -HUGE_VAL : last_elements_.min_jacobian,
+        last_elements_.worst_element < 0 ? kNone : static_cast<long>(model_.whole_element(last_elements_.worst_element))};
+    dec_->min(dt_bound, worst);
+    last_elements_.min_jacobian = worst.first == -HUGE_VAL ? std::nan("") : worst.first;
+    last_elements_.worst_element = worst.second == kNone ? -1 : static_cast<Index>(worst.second);
+  }
   const double omega_e = 2.0 / dt_bound[0];
   stable_dt_ = fracture_ && fracture_->cohesive_count() > 0 ? 2.0 / std::sqrt(omega_e * omega_e - dt_bound[1])
                                                            : dt_bound[0];
-  if (dec_->distributed()) {
-    // The worst element over all ranks (NaN first, then the smallest det F,
-    // then the smallest index, as on one rank).
-    // (By the whole model's element index: a part's local ones differ.)
-    struct {
-      double J;
-      int e;
-    } worst{std::isnan(last_elements_.min_jacobian) ? -HUGE_VAL : last_elements_.min_jacobian,
-            last_elements_.worst_element < 0 ? std::numeric_limits<int>::max()
-                                             : model_.whole_element(last_elements_.worst_element)};
-    MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE_INT, MPI_MINLOC, dec_->comm());
-    last_elements_.min_jacobian = worst.J == -HUGE_VAL ? std::nan("") : worst.J;
-    last_elements_.worst_element = worst.e == std::numeric_limits<int>::max() ? -1 : worst.e;
-  }
   if (!(last_elements_.min_jacobian > 0)) {
     const double J = last_elements_.min_jacobian;
     // Its owner has its current positions, its id and body.
@@ -473,7 +470,10 @@ void Simulation::update_ledger() {
   t[kDissipated] = cohesive_energy_.dissipated;
   std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);
   step_work_ = {};
-  timed(comm_seconds_, [&] { dec_->sum(t); });
+  // The stop signal travels with the sums (run() reads it after the step).
+  long stop[1] = {stop_signal()};
+  timed(comm_seconds_, [&] { dec_->sum(t, stop); });
+  stop_ = static_cast<int>(stop[0]);
   ledger_.kinetic = t[kKinetic].value();
   ledger_.momentum = Vec3(t[kP].value(), t[kP + 1].value(), t[kP + 2].value());
   ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());

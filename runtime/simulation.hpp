@@ -243,6 +243,7 @@ class Simulation {
   StepControl step_control_;
   long step_ = 0;
   Ledger ledger_;
+  int stop_ = 0;  ///< the largest stop signal any rank had at the last update_ledger()
   ElementLoopResult last_elements_;
   std::unique_ptr<ShellForces> shells_;  ///< null without shell bodies
   ShellLoopResult last_shells_;

@@ -86,7 +86,7 @@ long Simulation::run() {
     const bool field_row = field_every > 0 && (step_ % field_every == 0 || last);
     if (step_ % scene.history_every == 0 || last || field_row) write_outputs(field_row);
     progress.update(step_, time_, dt_, energy_error(), last);
-    const int stop = last ? 0 : dec_->max(stop_signal());
+    const int stop = last ? 0 : stop_;
     const auto now = std::chrono::steady_clock::now();
     const std::optional<CheckpointSpec>& every = scene.checkpoint;
     // Rank 0's clock decides for every rank.

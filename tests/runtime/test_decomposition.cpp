@@ -176,6 +176,25 @@ TEST(Decomposition, KeyPositionsAreThoseInTheSortedUnion) {
   EXPECT_EQ(std::count(none.position.begin(), none.position.end(), -1), static_cast<long>(queried.size()));
 }
 
+TEST(Decomposition, MinimaAndTheLeastPairTravelInOneMessage) {
+  // The stable step's bounds and the worst element: element-wise minima, and the
+  // least (key, index) pair, a tie on the key going to the smaller index.
+  const Decomposition d(box(), MPI_COMM_WORLD);
+  const int rank = world_rank(), size = world_size();
+  double values[2] = {1.0 + rank, -0.5 * rank};
+  std::pair<double, long> least{rank == 0 ? 2.0 : -1.0, 10L - rank};
+  d.min(values, least);
+  EXPECT_EQ(values[0], 1.0);
+  EXPECT_EQ(values[1], -0.5 * (size - 1));
+  EXPECT_EQ(least.first, size == 1 ? 2.0 : -1.0);
+  EXPECT_EQ(least.second, 10L - (size - 1));
+  // -inf (the NaN marker) wins over any key; the sentinel index survives.
+  std::pair<double, long> worst{rank == size - 1 ? -HUGE_VAL : 0.5, rank == size - 1 ? 3L : 1L};
+  d.min(values, worst);
+  EXPECT_EQ(worst.first, -HUGE_VAL);
+  EXPECT_EQ(worst.second, 3L);
+}
+
 TEST(Decomposition, ExactSumsAndRestrictedForcesAreSerial) {
   const Model& m = box();
   const Decomposition d(m, MPI_COMM_WORLD);

@@ -133,5 +133,26 @@ TEST(ExactSumMpi, EveryRankSplitGivesTheSerialBits) {
   }
 }
 
+TEST(ExactSumMpi, MaximaAndSpecialsTravelWithTheSums) {
+  // One message carries the digits, the specials and the maxima: each arrives whole
+  // (a lost or misplaced word shows in one of the three).
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const std::vector<double> t = hostile_terms(7);
+  ExactSum mine[3];
+  for (size_t i = rank; i < t.size(); i += size) mine[0] += t[i];
+  if (rank == size - 1) mine[1] += HUGE_VAL;  // one rank's infinity makes the sum infinite
+  mine[2] += 0.5 * rank;
+  long most[3] = {7L * rank - 3, -rank, std::numeric_limits<long>::min() + rank};
+  allreduce(mine, MPI_COMM_WORLD, most);
+  EXPECT_TRUE(same_bits(mine[0].value(), sum_in_order(t)));
+  EXPECT_EQ(mine[1].value(), HUGE_VAL);
+  EXPECT_EQ(mine[2].value(), 0.25 * size * (size - 1));
+  EXPECT_EQ(most[0], 7L * (size - 1) - 3);
+  EXPECT_EQ(most[1], 0);
+  EXPECT_EQ(most[2], std::numeric_limits<long>::min() + size - 1);
+}
+
 }  // namespace
 }  // namespace shatter
