@@ -288,6 +288,8 @@ DecompositionStats Decomposition::stats() const {
   return {-v[0], v[1], v[2], v[3], v[4]};
 }
 
+std::size_t Decomposition::sum_bytes(std::size_t count, std::size_t maxima) { return allreduce_bytes(count, maxima); }
+
 void Decomposition::sum(std::span<ExactSum> values, std::span<long> most) const {
   if (size_ > 1) allreduce(values, comm_, most);
 }

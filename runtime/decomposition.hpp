@@ -163,8 +163,8 @@ class Decomposition {
   /// (exact; ~570 bytes per accumulator, whatever the model), and every rank's
   /// `most` their element-wise maxima, in the same message.
   void sum(std::span<ExactSum> values, std::span<long> most = {}) const;
-  /// Bytes one sum() of `count` accumulators sends per rank.
-  static std::size_t sum_bytes(std::size_t count) { return count * (sizeof(std::int64_t) * ExactSum::kDigits + 8); }
+  /// Bytes one sum() of `count` accumulators and `maxima` maxima sends per rank.
+  static std::size_t sum_bytes(std::size_t count, std::size_t maxima = 0);
   /// In place: `root`'s values on every rank.
   void broadcast(std::span<double> values, int root) const;
   /// `root`'s text on every rank.

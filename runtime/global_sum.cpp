@@ -13,8 +13,10 @@ namespace {
 // It is one element of its own contiguous type, so the operation sees it whole.
 constexpr int kWords = ExactSum::kDigits + 1;
 
+size_t message_words(size_t accumulators, size_t maxima) { return 1 + accumulators * kWords + maxima; }
+
 std::vector<std::int64_t> pack(std::span<ExactSum> acc, std::span<const long> most) {
-  std::vector<std::int64_t> words(1 + acc.size() * kWords + most.size());
+  std::vector<std::int64_t> words(message_words(acc.size(), most.size()));
   words[0] = static_cast<std::int64_t>(most.size());
   for (size_t k = 0; k < acc.size(); ++k) {
     acc[k].normalize();
@@ -82,6 +84,10 @@ struct MessageType {
 };
 
 }  // namespace
+
+std::size_t allreduce_bytes(std::size_t accumulators, std::size_t maxima) {
+  return sizeof(std::int64_t) * message_words(accumulators, maxima);
+}
 
 void allreduce(std::span<ExactSum> acc, MPI_Comm comm, std::span<long> most) {
   static_assert(sizeof(long) == sizeof(std::int64_t));

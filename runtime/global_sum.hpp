@@ -7,6 +7,7 @@
 // user-defined operation.
 #include <mpi.h>
 
+#include <cstddef>
 #include <span>
 
 #include "kernels/exact_sum.hpp"
@@ -16,6 +17,8 @@ namespace shatter {
 /// Every rank's accumulators summed, and every rank's `most` replaced by the
 /// element-wise maxima over the ranks, on every rank (collective over `comm`).
 void allreduce(std::span<ExactSum> accumulators, MPI_Comm comm, std::span<long> most = {});
+/// Bytes of one allreduce's message: `accumulators` sums and `maxima` maxima.
+std::size_t allreduce_bytes(std::size_t accumulators, std::size_t maxima = 0);
 /// The sums only, the result on `root` only (the others' are left as they were).
 void reduce_to_root(std::span<ExactSum> accumulators, MPI_Comm comm, int root = 0);
 

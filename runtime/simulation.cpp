@@ -470,10 +470,9 @@ void Simulation::update_ledger() {
   t[kDissipated] = cohesive_energy_.dissipated;
   std::copy(step_work_.begin(), step_work_.end(), t.begin() + kLocal);
   step_work_ = {};
-  // The stop signal travels with the sums (run() reads it after the step).
-  long stop[1] = {stop_signal()};
-  timed(comm_seconds_, [&] { dec_->sum(t, stop); });
-  stop_ = static_cast<int>(stop[0]);
+  std::array<long, kLedgerMaxima> most{stop_signal()};
+  timed(comm_seconds_, [&] { dec_->sum(t, most); });
+  stop_ = static_cast<int>(most[0]);
   ledger_.kinetic = t[kKinetic].value();
   ledger_.momentum = Vec3(t[kP].value(), t[kP + 1].value(), t[kP + 2].value());
   ledger_.angular_momentum = Vec3(t[kL].value(), t[kL + 1].value(), t[kL + 2].value());

@@ -214,6 +214,8 @@ class Simulation {
   /// momentum (3), angular momentum (3), strain, cohesive stored and
   /// dissipated, and the step's works.
   static constexpr int kLedgerSums = 10 + kStepWorks;
+  /// Maxima in the same message: the stop signal (run() reads it after the step).
+  static constexpr int kLedgerMaxima = 1;
 
   Model& model_;
   RunOptions opt_;
