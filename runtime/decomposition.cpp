@@ -1,8 +1,9 @@
 #include "runtime/decomposition.hpp"
 
 #include <algorithm>
-#include <map>
+#include <cmath>
 #include <cstdlib>
+#include <map>
 #include <numeric>
 #include <string>
 
@@ -361,8 +362,9 @@ void Decomposition::min(std::span<double> values) const {
 
 namespace {
 
-// A message of doubles, one element: minima, then a (key, index) pair compared
-// lexicographically (the index is an integer below 2^53, exact as a double).
+// A message of doubles, one element: minima (a NaN wins, whatever the order, so every
+// rank gets the same), then a (key, index) pair compared lexicographically (the index
+// is an integer below 2^53, exact as a double).
 void min_then_least(void* in, void* inout, int* len, MPI_Datatype* type) {
   int bytes = 0;
   MPI_Type_size(*type, &bytes);
@@ -370,7 +372,7 @@ void min_then_least(void* in, void* inout, int* len, MPI_Datatype* type) {
   for (int e = 0; e < *len; ++e) {
     const double* a = static_cast<const double*>(in) + e * n;
     double* b = static_cast<double*>(inout) + e * n;
-    for (size_t i = 0; i + 2 < n; ++i) b[i] = std::min(a[i], b[i]);
+    for (size_t i = 0; i + 2 < n; ++i) b[i] = std::isnan(a[i]) || a[i] < b[i] ? a[i] : b[i];
     if (a[n - 2] < b[n - 2] || (a[n - 2] == b[n - 2] && a[n - 1] < b[n - 1])) b[n - 2] = a[n - 2], b[n - 1] = a[n - 1];
   }
 }

@@ -181,15 +181,18 @@ TEST(Decomposition, MinimaAndTheLeastPairTravelInOneMessage) {
   // least (key, index) pair, a tie on the key going to the smaller index.
   const Decomposition d(box(), MPI_COMM_WORLD);
   const int rank = world_rank(), size = world_size();
-  double values[2] = {1.0 + rank, -0.5 * rank};
+  // (A NaN on one rank wins on every rank, whatever the order the ranks combine in.)
+  double values[3] = {1.0 + rank, -0.5 * rank, rank == size - 1 ? std::nan("") : 1.0};
   std::pair<double, long> least{rank == 0 ? 2.0 : -1.0, 10L - rank};
   d.min(values, least);
   EXPECT_EQ(values[0], 1.0);
   EXPECT_EQ(values[1], -0.5 * (size - 1));
+  EXPECT_TRUE(std::isnan(values[2]));
   EXPECT_EQ(least.first, size == 1 ? 2.0 : -1.0);
   EXPECT_EQ(least.second, 10L - (size - 1));
   // -inf (the NaN marker) wins over any key; the sentinel index survives.
   std::pair<double, long> worst{rank == size - 1 ? -HUGE_VAL : 0.5, rank == size - 1 ? 3L : 1L};
+  values[2] = 1.0;
   d.min(values, worst);
   EXPECT_EQ(worst.first, -HUGE_VAL);
   EXPECT_EQ(worst.second, 3L);
