@@ -1,8 +1,6 @@
 #include "runtime/decomposition.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <string>
@@ -360,43 +358,8 @@ void Decomposition::min(std::span<double> values) const {
   if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MIN, comm_);
 }
 
-namespace {
-
-// A message of doubles, one element: minima (a NaN wins, whatever the order, so every
-// rank gets the same), then a (key, index) pair compared lexicographically (the index
-// is an integer below 2^53, exact as a double).
-void min_then_least(void* in, void* inout, int* len, MPI_Datatype* type) {
-  int bytes = 0;
-  MPI_Type_size(*type, &bytes);
-  const auto n = static_cast<size_t>(bytes) / sizeof(double);
-  for (int e = 0; e < *len; ++e) {
-    const double* a = static_cast<const double*>(in) + e * n;
-    double* b = static_cast<double*>(inout) + e * n;
-    for (size_t i = 0; i + 2 < n; ++i) b[i] = std::isnan(a[i]) || a[i] < b[i] ? a[i] : b[i];
-    if (a[n - 2] < b[n - 2] || (a[n - 2] == b[n - 2] && a[n - 1] < b[n - 1])) b[n - 2] = a[n - 2], b[n - 1] = a[n - 1];
-  }
-}
-
-}  // namespace
-
 void Decomposition::min(std::span<double> values, std::pair<double, long>& least) const {
-  if (size_ == 1) return;
-  static const MPI_Op op = [] {
-    MPI_Op made;
-    MPI_Op_create(&min_then_least, 1, &made);
-    return made;
-  }();
-  SHATTER_REQUIRE(std::abs(least.second) < (1L << 53), "Decomposition::min: index " << least.second << " beyond 2^53");
-  std::vector<double> message(values.begin(), values.end());
-  message.push_back(least.first);
-  message.push_back(static_cast<double>(least.second));
-  MPI_Datatype type;
-  MPI_Type_contiguous(static_cast<int>(message.size()), MPI_DOUBLE, &type);
-  MPI_Type_commit(&type);
-  MPI_Allreduce(MPI_IN_PLACE, message.data(), 1, type, op, comm_);
-  MPI_Type_free(&type);
-  std::copy(message.begin(), message.end() - 2, values.begin());
-  least = {message[message.size() - 2], static_cast<long>(message.back())};
+  if (size_ > 1) allreduce_min(values, least, comm_);
 }
 
 void Decomposition::max(std::span<double> values) const {

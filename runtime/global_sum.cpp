@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
+#include <cstdlib>
 #include <vector>
+
+#include "kernels/error.hpp"
 
 namespace shatter {
 
@@ -62,19 +66,37 @@ void combine(void* in, void* inout, int* len, MPI_Datatype* type) {
   }
 }
 
-MPI_Op combine_op() {
-  static const MPI_Op op = [] {
-    MPI_Op made;
-    MPI_Op_create(&combine, 1, &made);
-    return made;
-  }();
-  return op;
+// A message of doubles, one element: minima (a NaN wins, whatever the order, so every
+// rank gets the same), then a (key, index) pair compared lexicographically (the index
+// is an integer below 2^53, exact as a double).
+void min_then_least(void* in, void* inout, int* len, MPI_Datatype* type) {
+  int bytes = 0;
+  MPI_Type_size(*type, &bytes);
+  const auto n = static_cast<size_t>(bytes) / sizeof(double);
+  for (int e = 0; e < *len; ++e) {
+    const double* a = static_cast<const double*>(in) + e * n;
+    double* b = static_cast<double*>(inout) + e * n;
+    for (size_t i = 0; i + 2 < n; ++i) b[i] = std::isnan(a[i]) || a[i] < b[i] ? a[i] : b[i];
+    if (a[n - 2] < b[n - 2] || (a[n - 2] == b[n - 2] && a[n - 1] < b[n - 1])) b[n - 2] = a[n - 2], b[n - 1] = a[n - 1];
+  }
 }
 
-/// The message's type: its words as one element.
+/// A commutative operation made once `function`'s static instance is first used.
+template <MPI_User_function* function>
+MPI_Op op() {
+  static const MPI_Op made = [] {
+    MPI_Op o;
+    MPI_Op_create(function, 1, &o);
+    return o;
+  }();
+  return made;
+}
+
+/// A message's type: its `count` words of `word` as one element, so that an operation
+/// sees it whole.
 struct MessageType {
-  explicit MessageType(size_t words) {
-    MPI_Type_contiguous(static_cast<int>(words), MPI_INT64_T, &type);
+  MessageType(size_t count, MPI_Datatype word) {
+    MPI_Type_contiguous(static_cast<int>(count), word, &type);
     MPI_Type_commit(&type);
   }
   ~MessageType() { MPI_Type_free(&type); }
@@ -92,8 +114,8 @@ std::size_t allreduce_bytes(std::size_t accumulators, std::size_t maxima) {
 void allreduce(std::span<ExactSum> acc, MPI_Comm comm, std::span<long> most) {
   static_assert(sizeof(long) == sizeof(std::int64_t));
   std::vector<std::int64_t> words = pack(acc, most);
-  const MessageType message(words.size());
-  MPI_Allreduce(MPI_IN_PLACE, words.data(), 1, message.type, combine_op(), comm);
+  const MessageType message(words.size(), MPI_INT64_T);
+  MPI_Allreduce(MPI_IN_PLACE, words.data(), 1, message.type, op<&combine>(), comm);
   unpack(words, acc, most);
 }
 
@@ -101,9 +123,20 @@ void reduce_to_root(std::span<ExactSum> acc, MPI_Comm comm, int root) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   std::vector<std::int64_t> words = pack(acc, {}), out(rank == root ? words.size() : 0);
-  const MessageType message(words.size());
-  MPI_Reduce(words.data(), out.data(), 1, message.type, combine_op(), root, comm);
+  const MessageType message(words.size(), MPI_INT64_T);
+  MPI_Reduce(words.data(), out.data(), 1, message.type, op<&combine>(), root, comm);
   if (rank == root) unpack(out, acc, {});
+}
+
+void allreduce_min(std::span<double> values, std::pair<double, long>& least, MPI_Comm comm) {
+  SHATTER_REQUIRE(std::abs(least.second) < (1L << 53), "allreduce_min: index " << least.second << " beyond 2^53");
+  std::vector<double> message(values.begin(), values.end());
+  message.push_back(least.first);
+  message.push_back(static_cast<double>(least.second));
+  const MessageType type(message.size(), MPI_DOUBLE);
+  MPI_Allreduce(MPI_IN_PLACE, message.data(), 1, type.type, op<&min_then_least>(), comm);
+  std::copy(message.begin(), message.end() - 2, values.begin());
+  least = {message[message.size() - 2], static_cast<long>(message.back())};
 }
 
 }  // namespace shatter

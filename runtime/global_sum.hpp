@@ -1,14 +1,16 @@
 #pragma once
-// Global sums of ExactSum accumulators over MPI ranks (kernels/exact_sum.hpp):
-// integer sums of the digits, so the result does not depend on the number of
-// ranks or on which rank added which term. Constant size: ~570 bytes per
-// accumulator, whatever the model. One message per reduction: the digits, the
-// specials (infinities, NaN) and any maxima travel together, through one
-// user-defined operation.
+// Global reductions over MPI ranks, one message each, through user-defined
+// operations:
+// - sums of ExactSum accumulators (kernels/exact_sum.hpp): integer sums of the
+//   digits, so the result does not depend on the number of ranks or on which
+//   rank added which term; ~570 bytes per accumulator, whatever the model. The
+//   specials (infinities, NaN) and any maxima travel with the digits.
+// - minima with a least (key, index) pair (the stable step and the worst element).
 #include <mpi.h>
 
 #include <cstddef>
 #include <span>
+#include <utility>
 
 #include "kernels/exact_sum.hpp"
 
@@ -21,5 +23,9 @@ void allreduce(std::span<ExactSum> accumulators, MPI_Comm comm, std::span<long> 
 std::size_t allreduce_bytes(std::size_t accumulators, std::size_t maxima = 0);
 /// The sums only, the result on `root` only (the others' are left as they were).
 void reduce_to_root(std::span<ExactSum> accumulators, MPI_Comm comm, int root = 0);
+/// Every rank's `values` replaced by their element-wise minima over the ranks (a NaN
+/// on any rank wins on every rank), and `least` by the least (key, index) pair (the
+/// smaller key, then the smaller index: MPI's MINLOC order; |index| < 2^53).
+void allreduce_min(std::span<double> values, std::pair<double, long>& least, MPI_Comm comm);
 
 }  // namespace shatter

@@ -278,7 +278,8 @@ void Simulation::write_summary(double wall, const DecompositionStats& stats, con
   }
   // No contact surface state goes to every rank any more (the patches, docs/parallel.md).
   j.add("shared_surface_bytes_per_step", 0L);
-  // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work).
+  // The ledger's exact sums (update_ledger: 7 node terms, the strain energy, the step's work)
+  // and the stop signal, one message.
   j.add("reduction_bytes_per_step", static_cast<long>(dec_->distributed() ? Decomposition::sum_bytes(kLedgerSums, kLedgerMaxima) : 0));
   // The contact stage's exchanges included (contact_exchange_time).
   j.add("communication_time", comm_seconds_ + (contact_ ? contact_->profile().exchange_seconds : 0.0));
