@@ -169,7 +169,7 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
   kept_at_.clear();
   for (const Index n : kept_) kept_at_.push_back(known_[n].position);
   for (int p = 0; p < 3; ++p)
-    if (plans_[p]) plans_[p] = halo_of(lists_[p]);
+    if (plans_[p]) make_halos(static_cast<PatchPlan>(p));
 }
 
 void ContactPatch::forget() {
@@ -193,6 +193,7 @@ void ContactPatch::forget() {
 void ContactPatch::own(const NamedSurface& primitives) {
   owned_once_ = true;
   for (int p = 0; p < 3; ++p) plans_[p].reset(), lists_[p] = {};
+  fresh_.reset();
   owned_ = {}, patch_ = {}, normals_ = {}, normals_around_ = {};
   renumber(kept_);
   forget();
@@ -227,7 +228,7 @@ void ContactPatch::own(const NamedSurface& primitives) {
   for (size_t k = 0; k < known_.size(); ++k) position[k] = known_[k].position;
   relabel(owned, position);
   owned_ = std::move(owned);
-  plans_[static_cast<int>(PatchPlan::Owned)] = halo_of(lists);
+  make_halos(PatchPlan::Owned);
 }
 
 void ContactPatch::add_node(Index n, std::vector<Index>& nodes) {
@@ -320,6 +321,7 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   sort_by_whole(nodes);
   for (const PatchPlan p : {PatchPlan::Patch, PatchPlan::Active})
     plans_[static_cast<int>(p)].reset(), lists_[static_cast<int>(p)] = {};
+  fresh_.reset();
   normals_ = {}, normals_around_ = {};
   renumber(std::move(nodes));
   patch_ = {};
@@ -328,9 +330,8 @@ void ContactPatch::reach(std::span<const Vec3> x_old, std::span<const Vec3> x_ne
   for (const auto& [a, b] : edges) patch_.edges.push_back({known_[a].position, known_[b].position});
   for (const Index n : vertices) patch_.vertices.push_back(known_[n].position);
   std::sort(patch_.vertices.begin(), patch_.vertices.end());
-  auto& lists = lists_[static_cast<int>(PatchPlan::Patch)];
-  lists = plan(needed, false);
-  plans_[static_cast<int>(PatchPlan::Patch)] = halo_of(lists);
+  lists_[static_cast<int>(PatchPlan::Patch)] = plan(needed, false);
+  make_halos(PatchPlan::Patch);
 }
 
 SweptBoxes ContactPatch::patch_boxes(double margin) const {
@@ -350,17 +351,17 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 }
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
-  // The pairs' nodes, and the triangles around them that orient the pairs with their nodes
-  // (their rings, fetched by reach(): the pairs' nodes are the patch primitives'), marked by
-  // patch node: the patch numbering ascends with the whole ids, so the marked nodes read in
-  // order are sorted by whole id.
+  // The pairs' nodes (1), and the triangles around them that orient the pairs with their
+  // nodes (2 for a node of theirs only: their rings, fetched by reach(): the pairs' nodes are
+  // the patch primitives'), marked by patch node: the patch numbering ascends with the whole
+  // ids, so the marked nodes read in order are sorted by whole id.
   std::vector<std::uint8_t> at(nodes_.size(), 0);
   for (const ContactPair& p : pairs)
     for (const Index k : p.nodes) at[k] = 1;
   std::vector<Index> triangles;
   ring_mark_.resize(ring_.triangles.size(), 0);
   for (size_t k = 0; k < at.size(); ++k)
-    if (at[k])
+    if (at[k] == 1)
       for (const Index t : ring_of(nodes_[k]))
         if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
   for (const Index t : triangles) ring_mark_[t] = 0;
@@ -369,11 +370,12 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (const Index t : triangles)
     for (const Index n : ring_.triangles[t]) {
       SHATTER_ASSERT(known_[n].position >= 0);
-      at[known_[n].position] = 1;
+      if (!at[known_[n].position]) at[known_[n].position] = 2;
     }
   std::vector<Index> needed;
+  std::vector<std::uint8_t> velocity;
   for (size_t k = 0; k < at.size(); ++k)
-    if (at[k]) needed.push_back(nodes_[k]);
+    if (at[k]) needed.push_back(nodes_[k]), velocity.push_back(at[k] == 1);
   // reach() holds the rings' nodes in the patch. Only the triangles, their vertices and the
   // vertex -> triangle lists are made (surface_normal's needs).
   normals_ = {};
@@ -387,10 +389,8 @@ void ContactPatch::activate(std::span<const ContactPair> pairs) {
   for (size_t k = 0; k < vertex_mark.size(); ++k)
     if (vertex_mark[k]) normals_.vertices.push_back(static_cast<Index>(k));
   normals_around_ = vertex_triangles(normals_);
-  auto& lists = lists_[static_cast<int>(PatchPlan::Active)];
-  lists = plan(needed, true);
-  plans_[static_cast<int>(PatchPlan::Active)] = halo_of(lists);
-  active_fresh_ = true;
+  lists_[static_cast<int>(PatchPlan::Active)] = plan(needed, true, velocity);
+  make_halos(PatchPlan::Active);
 }
 
 Index ContactPatch::ring_triangle(const NamedTriangle& t) {
@@ -466,33 +466,69 @@ void ContactPatch::fetch_rings(std::span<const Index> vertices) {
   }
 }
 
-ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool readers) {
+ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool readers,
+                                           std::span<const std::uint8_t> velocity) {
   const int ranks = dec_.size(), me = dec_.rank();
   PlanLists lists;
+  // A request names a node by its whole id, or by -(whole id + 1) if its velocity stays.
   std::vector<std::vector<Index>> requests(ranks);
-  for (const Index n : nodes) {
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    const Index n = nodes[k];
     const int owner = known_[n].owner;
     if (owner == me) continue;
+    const bool v = velocity.empty() || velocity[k];
     lists.receive[owner].push_back(n);
-    requests[owner].push_back(known_[n].whole);
+    lists.receive_velocity[owner].push_back(v);
+    requests[owner].push_back(v ? known_[n].whole : -(known_[n].whole + 1));
   }
   const std::vector<std::vector<Index>> asked = dec_.alltoall(requests);
   for (int r = 0; r < ranks; ++r)
-    for (const Index whole : asked[r]) {
-      const Index n = held(whole);
+    for (const Index word : asked[r]) {
+      const Index n = held(word < 0 ? -word - 1 : word);
       SHATTER_ASSERT(n >= 0);
       lists.send[r].push_back(n);
+      lists.send_velocity[r].push_back(word >= 0);
     }
   if (readers) find_readers(lists);
   return lists;
 }
 
-std::unique_ptr<Halo> ContactPatch::halo_of(const PlanLists& lists) const {
-  std::map<int, std::vector<Index>> receive;
-  for (const auto& [r, list] : lists.receive)
-    for (const Index n : list) receive[r].push_back(known_[n].position);
-  return std::make_unique<Halo>(num_nodes_, num_nodes(), exchange_from(lists.send), exchange_from(receive),
-                                dec_.comm(), kPatchTag);
+void ContactPatch::make_halos(PatchPlan p) {
+  const PlanLists& lists = lists_[static_cast<int>(p)];
+  const Index patch_nodes = num_nodes();
+  // The lists' nodes in the numberings of the arrays exchanged: a node's own for the owned
+  // and patch plans; for the active one, stacked x_old, x_new, v (Halo::update_stacked).
+  const auto halo = [&](auto send_entry, auto receive_entry, Index arrays) {
+    std::map<int, std::vector<Index>> send, receive;
+    for (const auto& [r, list] : lists.send)
+      for (size_t k = 0; k < list.size(); ++k) send_entry(send[r], list[k], k, r, num_nodes_);
+    for (const auto& [r, list] : lists.receive)
+      for (size_t k = 0; k < list.size(); ++k) receive_entry(receive[r], known_[list[k]].position, k, r, patch_nodes);
+    // (no message where a rank has no entry for another: the two sides agree on that)
+    const auto empty = [](const auto& entry) { return entry.second.empty(); };
+    std::erase_if(send, empty), std::erase_if(receive, empty);
+    return std::make_unique<Halo>(arrays * num_nodes_, arrays * patch_nodes, exchange_from(send),
+                                  exchange_from(receive), dec_.comm(), kPatchTag);
+  };
+  if (p != PatchPlan::Active) {
+    const auto own = [](std::vector<Index>& out, Index n, size_t, int, Index) { out.push_back(n); };
+    plans_[static_cast<int>(p)] = halo(own, own, 1);
+    return;
+  }
+  // Between searches: x_new of every node, then v of the pairs' nodes. A node of the
+  // triangles around them only orients the pairs, at x_old (the last step's x_new): its
+  // velocity is not read. Right after the search, which brought the primitives' nodes, the
+  // x_old and x_new of the others.
+  const auto entries = [](const std::map<int, std::vector<std::uint8_t>>& velocity, bool fresh) {
+    return [&velocity, fresh](std::vector<Index>& out, Index n, size_t k, int r, Index size) {
+      const bool v = velocity.at(r)[k];
+      if (fresh && !v) out.push_back(n), out.push_back(size + n);
+      if (!fresh) out.push_back(size + n);
+      if (!fresh && v) out.push_back(2 * size + n);
+    };
+  };
+  plans_[static_cast<int>(p)] = halo(entries(lists.send_velocity, false), entries(lists.receive_velocity, false), 3);
+  fresh_ = halo(entries(lists.send_velocity, true), entries(lists.receive_velocity, true), 3);
 }
 
 void ContactPatch::find_readers(const PlanLists& lists) {
@@ -518,7 +554,6 @@ void ContactPatch::find_readers(const PlanLists& lists) {
   for (size_t k = 0; k < home.size(); ++k) reader_offsets_[k + 1] += reader_offsets_[k];
 }
 
-Halo* ContactPatch::halo(PatchPlan plan) const { return plans_[static_cast<int>(plan)].get(); }
 
 void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
                         std::span<const double> inv_mass, std::span<const std::uint8_t> held) {
@@ -541,10 +576,18 @@ void ContactPatch::store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span
 
 long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
                             PatchPlan plan) {
-  Halo* h = halo(plan);
+  if (plan == PatchPlan::Active) {
+    // The fresh plan once, right after the search; then the one between searches.
+    std::unique_ptr<Halo> fresh = std::move(fresh_);
+    Halo* h = fresh ? fresh.get() : plans_[static_cast<int>(plan)].get();
+    if (!h) return 0;
+    const std::span<const Vec3> from[] = {x_old, x_new, v};
+    const std::span<Vec3> to[] = {x_old_, x_new_, v_};
+    h->update_stacked(from, to);
+    return static_cast<long>(h->update_bytes(3));
+  }
+  Halo* h = plans_[static_cast<int>(plan)].get();
   if (!h) return 0;
-  const bool states_only = plan == PatchPlan::Active && !active_fresh_;
-  if (plan == PatchPlan::Active) active_fresh_ = false;
   // The patch's plan brings what DCR reads of the nodes besides their states, as a fourth
   // array (the nodes' masses and conditions do not change between searches).
   std::vector<Vec3> data;
@@ -557,8 +600,8 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
   }
   const std::span<const Vec3> from[] = {x_old, x_new, v, part_data_};
   const std::span<Vec3> to[] = {x_old_, x_new_, v_, data};
-  const size_t skip = states_only ? 1 : 0, count = (with_data ? 4 : 3) - skip;
-  h->update(std::span(from).subspan(skip, count), std::span(to).subspan(skip, count));
+  const size_t count = with_data ? 4 : 3;
+  h->update(std::span(from).first(count), std::span(to).first(count));
   if (with_data)
     for (const auto& [r, list] : lists_[static_cast<int>(PatchPlan::Patch)].receive)
       for (const Index n : list) {

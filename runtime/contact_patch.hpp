@@ -150,9 +150,12 @@ class ContactPatch {
 
   /// The volume owners' x_old, x_new and v of the plan's nodes (the part's arrays) into the
   /// patch's, and with the patch's plan their inverse masses and held components (load()'s
-  /// arrays); returns the bytes this rank sent. After the first exchange of an active plan,
-  /// its x_old are not sent (load() sets them). Point to point; collective in the plan's
-  /// ranks. No-op before the plan is made.
+  /// arrays); returns the bytes this rank sent. The active plan brings less: its first
+  /// exchange, right after the search (whose patch plan brought the pairs' nodes), the
+  /// x_old and x_new of the nodes of the triangles around the pairs only; the later ones
+  /// x_new of every node (load() sets x_old) and v of the pairs' nodes only (the triangles
+  /// orient the pairs at x_old: their velocities are not read). Point to point; collective
+  /// in the plan's ranks. No-op before the plan is made.
   long exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
@@ -165,18 +168,21 @@ class ContactPatch {
 
  private:
   /// A plan's lists: the home nodes sent to each rank (part node ids), the nodes received
-  /// from each (known ids).
+  /// from each (known ids); per entry of each list, whether the node's velocity goes too (1)
+  /// or its positions only (0: the active plan's nodes of the triangles around the pairs).
   struct PlanLists {
     std::map<int, std::vector<Index>> send, receive;
+    std::map<int, std::vector<std::uint8_t>> send_velocity, receive_velocity;
   };
-  /// Plans the exchange of `nodes` (known ids) from their owners; with
-  /// `readers`, makes it the source of neighbors() and readers() (collective).
-  PlanLists plan(const std::vector<Index>& nodes, bool readers);
-  /// The Halo of a plan's lists, received into the patch's numbering.
-  std::unique_ptr<Halo> halo_of(const PlanLists& lists) const;
+  /// Plans the exchange of `nodes` (known ids) from their owners, with per node whether its
+  /// velocity goes (empty: every node's); with `readers`, makes it the source of neighbors()
+  /// and readers() (collective).
+  PlanLists plan(const std::vector<Index>& nodes, bool readers, std::span<const std::uint8_t> velocity = {});
+  /// The Halos of plan p's lists (lists_), received into the patch's numbering: plans_[p], and
+  /// for the active plan fresh_ too.
+  void make_halos(PatchPlan p);
   /// neighbors() and readers() from a plan's lists.
   void find_readers(const PlanLists& lists);
-  Halo* halo(PatchPlan plan) const;
   /// The patch's nodes become `nodes` (known ids ascending in whole id; the kept ones among them):
   /// states kept for the nodes that stay, the primitives' ids and the plans renumbered.
   void renumber(std::vector<Index> nodes);
@@ -242,7 +248,7 @@ class ContactPatch {
   std::vector<Index> ring_offsets_{0}, ring_items_;  ///< the rings fetched, CSR: ring_ indices, name order
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
-  bool active_fresh_ = false;       ///< the active plan has not been exchanged yet
+  std::unique_ptr<Halo> fresh_;     ///< the active plan's first exchange, until it is made
   std::vector<Index> nodes_;        ///< per patch node: its known id, ascending whole ids
   std::vector<Index> kept_at_;      ///< per kept_: its patch node
   std::vector<Vec3> x_old_, x_new_, v_;

@@ -115,4 +115,26 @@ void Halo::update(std::span<const std::span<const Vec3>> from, std::span<const s
     for (size_t k = 0; k < to.size(); ++k) std::copy_n(&recv_buffer_[p * c + 3 * k], 3, to[k][recv_.nodes[p]].data());
 }
 
+void Halo::update_stacked(std::span<const std::span<const Vec3>> from, std::span<const std::span<Vec3>> to) {
+  SHATTER_REQUIRE(!pending_, "Halo: an update while an update is pending");
+  // Entry e of a stack: its array and the place in it.
+  const auto at = [](auto arrays, Index e) {
+    size_t k = 0;
+    while (static_cast<size_t>(e) >= arrays[k].size()) e -= static_cast<Index>(arrays[k++].size());
+    return arrays[k].data() + e;
+  };
+  const auto size = [](auto arrays) {
+    size_t n = 0;
+    for (const auto& a : arrays) n += a.size();
+    return n;
+  };
+  check_size(3 * size(from), num_nodes_, 3);
+  check_size(3 * size(to), num_receive_nodes_, 3);
+  send_buffer_.resize(3 * send_.nodes.size());
+  for (size_t p = 0; p < send_.nodes.size(); ++p) std::copy_n(at(from, send_.nodes[p])->data(), 3, &send_buffer_[3 * p]);
+  post(3);
+  wait();
+  for (size_t p = 0; p < recv_.nodes.size(); ++p) std::copy_n(&recv_buffer_[3 * p], 3, at(to, recv_.nodes[p])->data());
+}
+
 }  // namespace shatter

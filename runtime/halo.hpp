@@ -65,6 +65,12 @@ class Halo {
   /// The same from one set of arrays into another (the constructor's two numberings):
   /// the send lists' entries of `from[k]` go into the receive lists' entries of `to[k]`.
   void update(std::span<const std::span<const Vec3>> from, std::span<const std::span<Vec3>> to);
+  /// One value per listed entry, the lists naming entries of arrays stacked end to end: entry
+  /// e of a send list is from[k][e - (the sizes of from[0..k-1])], and likewise for a receive
+  /// list and `to`. The sizes of `from` sum to the constructor's send nodes, those of `to` to
+  /// its receive nodes. So one message per rank carries some arrays' values for some nodes
+  /// and other arrays' for others.
+  void update_stacked(std::span<const std::span<const Vec3>> from, std::span<const std::span<Vec3>> to);
 
   /// Bytes this rank sends per update of `components` doubles per node.
   std::size_t update_bytes(int components) const { return send_.nodes.size() * components * sizeof(double); }

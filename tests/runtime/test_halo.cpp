@@ -4,9 +4,10 @@
 // own local numbering. The copies it receives get their owners' values bit
 // for bit (-0.0, subnormals, values near overflow), for any number of
 // components, blocking or split; entries not in a receive list keep theirs;
-// two Halos on one communicator never mix messages; calls out of order or
-// with arrays of the wrong size throw Error. Halo as the time loop uses it is
-// tested through Decomposition (test_decomposition).
+// two Halos on one communicator never mix messages; stacked arrays send each
+// node's chosen arrays; calls out of order or with arrays of the wrong size
+// throw Error. Halo as the time loop uses it is tested through Decomposition
+// (test_decomposition).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -156,6 +157,55 @@ TEST(Halo, UpdateDeliversTheOwnersValuesBitForBit) {
   }
   EXPECT_EQ(halo.update_bytes(3), static_cast<std::size_t>(sent) * 3 * sizeof(double));
   EXPECT_EQ(halo.update_messages(), messages);
+}
+
+// Two arrays stacked (update_stacked): every listed node's entry of the first, and the
+// second's of some listed nodes only (both()), in one message per rank.
+TEST(Halo, StackedArraysSendEachNodesChosenArrays) {
+  const Exchange x(holds_quarter);
+  const auto global = [&](Index local) { return (local - 7 * x.rank % kNodes + kNodes) % kNodes; };
+  const auto both = [](Index g) { return (g / 3) % 2 == 0; };  // (not a function of the owner)
+  const auto stacked = [&](const NodeExchange& lists) {
+    NodeExchange out;
+    for (int i = 0; i < lists.num_ranks(); ++i) {
+      out.ranks.push_back(lists.ranks[i]);
+      for (const Index n : lists.nodes_of(i)) out.nodes.push_back(n);
+      for (const Index n : lists.nodes_of(i))
+        if (both(global(n))) out.nodes.push_back(kNodes + n);
+      out.offsets.push_back(static_cast<Index>(out.nodes.size()));
+    }
+    return out;
+  };
+  Halo halo(2 * kNodes, 2 * kNodes, stacked(x.send), stacked(x.receive), MPI_COMM_WORLD, kGhostTag);
+  const auto value = [](Index g, double scale) {
+    return Vec3(owned_value(g, 0, scale), owned_value(g, 1, scale), owned_value(g, 2, scale));
+  };
+  std::vector<Vec3> a(kNodes, Vec3::Constant(kKept)), b = a;
+  for (Index g = 0; g < kNodes; ++g)
+    if (Exchange::owner(g, x.size) == x.rank) a[x.local(g)] = value(g, 1.0), b[x.local(g)] = value(g, -3.0);
+  const std::span<const Vec3> from[] = {a, b};
+  std::vector<Vec3> to_a = a, to_b = b;
+  const std::span<Vec3> to[] = {to_a, to_b};
+  halo.update_stacked(from, to);
+  long wrong = 0, second = 0;
+  for (Index g = 0; g < kNodes; ++g) {
+    const Index l = x.local(g);
+    const bool owned = Exchange::owner(g, x.size) == x.rank, got = x.received[l];
+    const Vec3 want_a = owned || got ? value(g, 1.0) : Vec3::Constant(kKept);
+    const Vec3 want_b = owned || (got && both(g)) ? value(g, -3.0) : Vec3::Constant(kKept);
+    wrong += std::memcmp(to_a[l].data(), want_a.data(), sizeof(Vec3)) != 0;
+    wrong += std::memcmp(to_b[l].data(), want_b.data(), sizeof(Vec3)) != 0;
+    second += got && both(g);
+  }
+  EXPECT_EQ(wrong, 0);
+  if (x.size > 1) {
+    EXPECT_GT(second, 0) << "some nodes receive both arrays";
+    EXPECT_LT(second, static_cast<long>(x.receive.nodes.size())) << "and some the first only";
+  }
+  EXPECT_EQ(halo.update_bytes(3), stacked(x.send).nodes.size() * 3 * sizeof(double));
+  // Stacks of the wrong total size throw.
+  const std::span<const Vec3> short_from[] = {a};
+  EXPECT_THROW(halo.update_stacked(short_from, to), Error);
 }
 
 TEST(Halo, TwoHalosOnOneCommunicatorDoNotMixMessages) {
