@@ -515,20 +515,28 @@ void ContactPatch::make_halos(PatchPlan p) {
     plans_[static_cast<int>(p)] = halo(own, own, 1);
     return;
   }
-  // Between searches: x_new of every node, then v of the pairs' nodes. A node of the
-  // triangles around them only orients the pairs, at x_old (the last step's x_new): its
-  // velocity is not read. Right after the search, which brought the primitives' nodes, the
-  // x_old and x_new of the others.
-  const auto entries = [](const std::map<int, std::vector<std::uint8_t>>& velocity, bool fresh) {
-    return [&velocity, fresh](std::vector<Index>& out, Index n, size_t k, int r, Index size) {
-      const bool v = velocity.at(r)[k];
-      if (fresh && !v) out.push_back(n), out.push_back(size + n);
-      if (!fresh) out.push_back(size + n);
-      if (!fresh && v) out.push_back(2 * size + n);
+  // Right after the search, which brought the primitives' nodes: x_old and x_new of the
+  // others (the triangles around the pairs, which orient them at x_old). Between searches:
+  // v of every node, whose x_new the receiver drifts from x_old (load()); a rigid body's
+  // node also sends x_new (its body places it).
+  const auto entries = [&](const std::map<int, std::vector<std::uint8_t>>& velocity, auto rigid, bool fresh) {
+    return [&velocity, rigid, fresh](std::vector<Index>& out, Index n, size_t k, int r, Index size) {
+      if (fresh && !velocity.at(r)[k]) out.push_back(n), out.push_back(size + n);
+      if (fresh) return;
+      if (rigid(n)) out.push_back(size + n);
+      out.push_back(2 * size + n);
     };
   };
-  plans_[static_cast<int>(p)] = halo(entries(lists.send_velocity, false), entries(lists.receive_velocity, false), 3);
-  fresh_ = halo(entries(lists.send_velocity, true), entries(lists.receive_velocity, true), 3);
+  const auto rigid_body = [this](int body) { return model_.scene.bodies[body].has_rigid_state(); };
+  const auto part_rigid = [&](Index n) { return rigid_body(model_.mesh.node_body[n]); };
+  const auto patch_rigid = [&](Index k) { return rigid_body(body(k)); };
+  plans_[static_cast<int>(p)] = halo(entries(lists.send_velocity, part_rigid, false),
+                                     entries(lists.receive_velocity, patch_rigid, false), 3);
+  fresh_ = halo(entries(lists.send_velocity, part_rigid, true), entries(lists.receive_velocity, patch_rigid, true), 3);
+  drifted_.clear();
+  for (const auto& [r, list] : lists.receive)
+    for (const Index n : list)
+      if (!patch_rigid(known_[n].position)) drifted_.push_back(known_[n].position);
 }
 
 void ContactPatch::find_readers(const PlanLists& lists) {
@@ -556,8 +564,8 @@ void ContactPatch::find_readers(const PlanLists& lists) {
 
 
 void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
-                        std::span<const double> inv_mass, std::span<const std::uint8_t> held) {
-  part_inv_mass_ = inv_mass, part_held_ = held;
+                        std::span<const double> inv_mass, std::span<const std::uint8_t> held, double dt) {
+  part_inv_mass_ = inv_mass, part_held_ = held, dt_ = dt;
   if (!held.empty()) held_.resize(nodes_.size(), 0);
   x_old_ = x_new_;
   for (size_t i = 0; i < kept_.size(); ++i) {
@@ -584,6 +592,10 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
     const std::span<const Vec3> from[] = {x_old, x_new, v};
     const std::span<Vec3> to[] = {x_old_, x_new_, v_};
     h->update_stacked(from, to);
+    // The central difference's drift, as the volume owner made it (no contraction: the same
+    // bits).
+    if (!fresh)
+      for (const Index k : drifted_) x_new_[k] = x_old_[k] + dt_ * v_[k];
     return static_cast<long>(h->update_bytes(3));
   }
   Halo* h = plans_[static_cast<int>(plan)].get();

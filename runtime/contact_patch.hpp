@@ -142,9 +142,11 @@ class ContactPatch {
   /// A step's start: the part's states, inverse masses and held components (empty: none)
   /// of the kept nodes into the patch's; every other patch node's x(n) is its x(n+1) of the
   /// last step (the time loop's x(n)), which its exchange or DCR's settle brought. The
-  /// arrays must stay until the step's exchanges are done.
+  /// arrays must stay until the step's exchanges are done. The states are the central
+  /// difference's: x_new = x_old + dt * v (bit for bit, as the time loop's drift makes it)
+  /// for every node but a rigid body's.
   void load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
-            std::span<const double> inv_mass, std::span<const std::uint8_t> held);
+            std::span<const double> inv_mass, std::span<const std::uint8_t> held, double dt);
   /// A step's end: the patch's states of the kept nodes back into the part's arrays.
   void store(std::span<Vec3> x_old, std::span<Vec3> x_new, std::span<Vec3> v) const;
 
@@ -152,10 +154,10 @@ class ContactPatch {
   /// patch's, and with the patch's plan their inverse masses and held components (load()'s
   /// arrays); returns the bytes this rank sent. The active plan brings less: its first
   /// exchange, right after the search (whose patch plan brought the pairs' nodes), the
-  /// x_old and x_new of the nodes of the triangles around the pairs only; the later ones
-  /// x_new of every node (load() sets x_old) and v of the pairs' nodes only (the triangles
-  /// orient the pairs at x_old: their velocities are not read). Point to point; collective
-  /// in the plan's ranks. No-op before the plan is made.
+  /// x_old and x_new of the nodes of the triangles around the pairs only (they orient the
+  /// pairs at x_old); the later ones v only, x_new being x_old (load()) + dt * v, but for a
+  /// rigid body's nodes. Point to point; collective in the plan's ranks. No-op before the
+  /// plan is made.
   long exchange(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v, PatchPlan plan);
 
   /// The ranks this one exchanges with in DCR (patch_ranks.hpp), ascending: those it sends
@@ -168,15 +170,15 @@ class ContactPatch {
 
  private:
   /// A plan's lists: the home nodes sent to each rank (part node ids), the nodes received
-  /// from each (known ids); per entry of each list, whether the node's velocity goes too (1)
+  /// from each (known ids); per entry of each list, whether the node's velocity is read (1)
   /// or its positions only (0: the active plan's nodes of the triangles around the pairs).
   struct PlanLists {
     std::map<int, std::vector<Index>> send, receive;
     std::map<int, std::vector<std::uint8_t>> send_velocity, receive_velocity;
   };
   /// Plans the exchange of `nodes` (known ids) from their owners, with per node whether its
-  /// velocity goes (empty: every node's); with `readers`, makes it the source of neighbors()
-  /// and readers() (collective).
+  /// velocity is read (empty: every node's); with `readers`, makes it the source of
+  /// neighbors() and readers() (collective).
   PlanLists plan(const std::vector<Index>& nodes, bool readers, std::span<const std::uint8_t> velocity = {});
   /// The Halos of plan p's lists (lists_), received into the patch's numbering: plans_[p], and
   /// for the active plan fresh_ too.
@@ -249,6 +251,8 @@ class ContactPatch {
   PlanLists lists_[3];              ///< per PatchPlan
   std::unique_ptr<Halo> plans_[3];  ///< per PatchPlan: lists_ in the patch's numbering
   std::unique_ptr<Halo> fresh_;     ///< the active plan's first exchange, until it is made
+  std::vector<Index> drifted_;      ///< the active plan's received nodes whose x_new is drifted here
+  double dt_ = 0;                   ///< load()'s step
   std::vector<Index> nodes_;        ///< per patch node: its known id, ascending whole ids
   std::vector<Index> kept_at_;      ///< per kept_: its patch node
   std::vector<Vec3> x_old_, x_new_, v_;

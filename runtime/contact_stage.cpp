@@ -510,7 +510,7 @@ DcrResult ContactStage::apply(std::span<Vec3> x_old, std::span<Vec3> x_new, std:
   };
   // The reuse check reads the owned surface vertices; the candidates' states come after it
   // (a search brings them itself).
-  if (dec_) patch_->load(x_old, x_new, v, inv_mass, held);
+  if (dec_) patch_->load(x_old, x_new, v, inv_mass, held, dt);
   const bool valid = candidates_valid(x_old, x_new);
   if (dec_ && valid) exchange(x_old, x_new, v, PatchPlan::Active);
   lap(profile_.verlet_seconds);

@@ -100,10 +100,12 @@ class ContactStage {
   /// impulses. inv_mass: inverse lumped masses, 0 for nodes DCR must not move;
   /// held (empty: none): per node, bit k = component k held (resolve_contacts).
   /// On several ranks the arrays' owned entries are the state; the patch's other
-  /// nodes are filled from their owners (x_new and v each step; x_old at a search,
-  /// while between searches x_old must be what this rank held as x_new at the end
-  /// of the last step, as the time loop's x(n) is), and every node a pair moved
-  /// gets its final state on every rank that touches it or holds it in its patch.
+  /// nodes are filled from their owners (at a search x_old, x_new and v; between
+  /// searches v, and x_new = x_old + dt * v as the time loop's drift makes it, bit for
+  /// bit, but for a rigid body's nodes, whose x_new comes too; x_old must then be what
+  /// this rank held as x_new at the end of the last step, as the time loop's x(n) is),
+  /// and every node a pair moved gets its final state on every rank that touches it or
+  /// holds it in its patch.
   /// The result's contacts, dissipated, support_work and work are then this rank's part;
   /// when capped, unresolved is the first pair over all ranks, in whole-model node ids.
   /// rigid (null: none): the free rigid bodies (resolve_contacts); the result's rigid sums

@@ -3,9 +3,10 @@
 // the ranks check together are the pairs a search of the whole surface gives,
 // each on exactly one rank, while every rank knows only its own nodes' states
 // (the others' x(n+1) and v are NaN; their x(n) is what the rank held as x(n+1)
-// at the end of the last step, as in the time loop). The patch keeps the states
-// it brings in arrays of its own: the part's rows of nodes outside its elements
-// (no rigid body here) stay NaN, so the search never read them.
+// at the end of the last step, and x(n+1) = x(n) + dt v, as in the time loop).
+// The patch keeps the states it brings in arrays of its own: the part's rows of
+// nodes outside its elements (no rigid body here) stay NaN, so the search never
+// read them.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -56,16 +57,19 @@ TEST(ContactPatch, RanksTogetherCheckTheWholeSurfacesPairsOnce) {
     for (Index i = 0; i < n; ++i) {
       const Vec3& X = m.mesh.reference[i];
       const Vec3 shift((s + 1) * step, 0, 0);
-      true_new[i] = m.mesh.node_body[i] == 0 ? Vec3(Vec3(X.x() * std::cos(angle) - X.y() * std::sin(angle),
-                                                          X.x() * std::sin(angle) + X.y() * std::cos(angle), X.z()) +
-                                                     shift)
-                                              : Vec3(X - shift);
+      const Vec3 to = m.mesh.node_body[i] == 0 ? Vec3(Vec3(X.x() * std::cos(angle) - X.y() * std::sin(angle),
+                                                            X.x() * std::sin(angle) + X.y() * std::cos(angle), X.z()) +
+                                                       shift)
+                                                : Vec3(X - shift);
+      // The central difference's states (dt = 1): x(n+1) = x(n) + v(n+1/2).
+      const Vec3 true_v = to - true_old[i];
+      true_new[i] = true_old[i] + 1.0 * true_v;
       // A rank knows the states of the nodes it owns, and x(n) of what it held at the end
       // of the last step.
       const bool mine = !dec.distributed() || dec.node_owner(i) == dec.rank();
       x_old[i] = mine ? true_old[i] : x_new[i];
       x_new[i] = mine ? true_new[i] : Vec3::Constant(nan);
-      v[i] = mine ? Vec3::Zero() : Vec3::Constant(nan);
+      v[i] = mine ? true_v : Vec3::Constant(nan);
     }
     const DcrResult r = stage.apply(x_old, x_new, v, inv_mass, 1.0);
     // (With DCR moving nothing, the rounds reach their cap once bodies penetrate: the first
