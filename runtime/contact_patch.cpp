@@ -351,19 +351,30 @@ SweptBoxes ContactPatch::patch_boxes(double margin) const {
 }
 
 void ContactPatch::activate(std::span<const ContactPair> pairs) {
-  // The pairs' nodes (1), and the triangles around them that orient the pairs with their
-  // nodes (2 for a node of theirs only: their rings, fetched by reach(): the pairs' nodes are
-  // the patch primitives'), marked by patch node: the patch numbering ascends with the whole
-  // ids, so the marked nodes read in order are sorted by whole id.
+  // The pairs' nodes (1), and the triangles whose normals orient the pairs (pair_normals):
+  // those around a vertex-face pair's vertex, and those through an edge-edge pair's two
+  // edges (from the rings, fetched by reach(): the pairs' nodes are the patch primitives').
+  // Their other nodes are 2. Marked by patch node: the patch numbering ascends with the
+  // whole ids, so the marked nodes read in order are sorted by whole id.
   std::vector<std::uint8_t> at(nodes_.size(), 0);
-  for (const ContactPair& p : pairs)
-    for (const Index k : p.nodes) at[k] = 1;
   std::vector<Index> triangles;
   ring_mark_.resize(ring_.triangles.size(), 0);
-  for (size_t k = 0; k < at.size(); ++k)
-    if (at[k] == 1)
-      for (const Index t : ring_of(nodes_[k]))
-        if (!ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
+  const auto orient = [&](Index vertex, Index other) {
+    for (const Index t : ring_of(nodes_[vertex])) {
+      const auto& nodes = ring_.triangles[t];
+      const bool through = other < 0 || std::find(nodes.begin(), nodes.end(), nodes_[other]) != nodes.end();
+      if (through && !ring_mark_[t]) ring_mark_[t] = 1, triangles.push_back(t);
+    }
+  };
+  for (const ContactPair& p : pairs) {
+    for (const Index k : p.nodes) at[k] = 1;
+    if (p.kind == ContactPair::VertexFace) {
+      orient(p.nodes[0], -1);
+    } else {
+      orient(p.nodes[0], p.nodes[1]);
+      orient(p.nodes[2], p.nodes[3]);
+    }
+  }
   for (const Index t : triangles) ring_mark_[t] = 0;
   // (name keys are unique and not negative)
   sort_by_key(triangles, [&](Index t) { return static_cast<std::uint64_t>(ring_keys_[t]); });

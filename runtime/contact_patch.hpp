@@ -89,7 +89,8 @@ class ContactPatch {
   /// Collective.
   void reach(std::span<const Vec3> x_old, std::span<const Vec3> x_new, double margin);
   /// PatchPlan::Active, until the next search: the nodes of `pairs` (this rank's candidates,
-  /// patch node ids) and of the triangles around them, whose normals orient the pairs.
+  /// patch node ids) and of the triangles whose normals orient the pairs (pair_normals: those
+  /// around a vertex-face pair's vertex, those through an edge-edge pair's edges).
   /// Collective.
   void activate(std::span<const ContactPair> pairs);
   /// The surface the search runs on here (surface order, patch node ids).
@@ -102,9 +103,10 @@ class ContactPatch {
   /// The owned primitive (numbered as in owned()) of a primitive of patch() (as in
   /// OwnedPairs), -1 for a ghost edge.
   Index owned_primitive(Index patch_primitive) const;
-  /// The triangles whose normals the active pairs read (those around their nodes), in
-  /// name order (the one-rank surface's), and their vertices (no edges), with their vertex ->
-  /// triangle lists (patch node ids).
+  /// The triangles whose normals the active pairs read (activate()), in name order (the
+  /// one-rank surface's), and their vertices (no edges), with their vertex -> triangle lists
+  /// (patch node ids): a vertex's list holds every triangle around it where a pair reads its
+  /// normal at the vertex, and those through the edge where a pair reads it at an edge.
   const ContactSurface& normals() const { return normals_; }
   const VertexTriangles& normals_around() const { return normals_around_; }
   /// The surface vertices whose volume owner this rank is, ascending (part node ids).
