@@ -168,8 +168,9 @@ void ContactPatch::renumber(std::vector<Index> nodes) {
     for (const Index n : nodes_) reach_.push_back(part_reach_[known_[n].node]);
   kept_at_.clear();
   for (const Index n : kept_) kept_at_.push_back(known_[n].position);
-  for (int p = 0; p < 3; ++p)
-    if (plans_[p]) make_halos(static_cast<PatchPlan>(p));
+  // (the patch and active plans are made anew after a new numbering: reach() drops them)
+  SHATTER_ASSERT(!plans_[static_cast<int>(PatchPlan::Patch)] && !plans_[static_cast<int>(PatchPlan::Active)]);
+  if (plans_[static_cast<int>(PatchPlan::Owned)]) make_halos(PatchPlan::Owned);
 }
 
 void ContactPatch::forget() {
@@ -481,7 +482,8 @@ ContactPatch::PlanLists ContactPatch::plan(const std::vector<Index>& nodes, bool
                                            std::span<const std::uint8_t> velocity) {
   const int ranks = dec_.size(), me = dec_.rank();
   PlanLists lists;
-  // A request names a node by its whole id, or by -(whole id + 1) if its velocity stays.
+  // A request names a node by its whole id, or by -(whole id + 1) if only its positions are
+  // read.
   std::vector<std::vector<Index>> requests(ranks);
   for (size_t k = 0; k < nodes.size(); ++k) {
     const Index n = nodes[k];
@@ -572,7 +574,6 @@ void ContactPatch::find_readers(const PlanLists& lists) {
   for (const auto& [k, r] : entries) ++reader_offsets_[k + 1], readers_.push_back(r);
   for (size_t k = 0; k < home.size(); ++k) reader_offsets_[k + 1] += reader_offsets_[k];
 }
-
 
 void ContactPatch::load(std::span<const Vec3> x_old, std::span<const Vec3> x_new, std::span<const Vec3> v,
                         std::span<const double> inv_mass, std::span<const std::uint8_t> held, double dt) {
