@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "contact/radix_sort.hpp"
+#include "kernels/drift.hpp"
 #include "kernels/error.hpp"
 #include "runtime/decomposition.hpp"
 #include "runtime/halo.hpp"
@@ -604,10 +605,9 @@ long ContactPatch::exchange(std::span<const Vec3> x_old, std::span<const Vec3> x
     const std::span<const Vec3> from[] = {x_old, x_new, v};
     const std::span<Vec3> to[] = {x_old_, x_new_, v_};
     h->update_stacked(from, to);
-    // The central difference's drift, as the volume owner made it (no contraction: the same
-    // bits).
+    // The central difference's drift, as the volume owner made it.
     if (!fresh)
-      for (const Index k : drifted_) x_new_[k] = x_old_[k] + dt_ * v_[k];
+      for (const Index k : drifted_) x_new_[k] = drift(x_old_[k], dt_, v_[k]);
     return static_cast<long>(h->update_bytes(3));
   }
   Halo* h = plans_[static_cast<int>(plan)].get();

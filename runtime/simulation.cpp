@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "kernels/drift.hpp"
 #include "kernels/error.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/contact_stage.hpp"
@@ -245,7 +246,7 @@ void Simulation::predict() {
   // The kick and the drift in one pass over the nodes.
   half_kick(true, [&](Index i) {
     if (keep) x_prev_[i] = x_[i];
-    x_[i] += dt_ * v_[i];
+    x_[i] = drift(x_[i], dt_, v_[i]);
   });
   bc_dx_.resize(bc_nodes_.size());
   for (size_t b = 0; b < bc_nodes_.size(); ++b) bc_dx_[b] = dt_ * v_[bc_nodes_[b]];
